@@ -1,0 +1,34 @@
+# mpipd — set-up, demo, tests, benchmarks.  `make demo` and `make test` each do the
+# whole set-up first (Debian packages, .venv, mpi4py + parallel h5py), idempotently.
+SHELL := /bin/bash
+VENV ?= .venv
+PY := $(VENV)/bin/python
+MPIRUN ?= mpirun
+STAMP := $(VENV)/.mpipd-installed
+
+# Open MPI: allow root (CI and this machine run as root) and more ranks than cores.
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+export OMP_NUM_THREADS := 1
+
+.PHONY: install demo test verify bench clean
+
+install: $(STAMP)
+
+$(STAMP): scripts/bootstrap.sh pyproject.toml
+	bash scripts/bootstrap.sh
+	touch $@
+
+demo: install
+	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run elastic_wave --out runs/demo --overwrite
+	@echo "demo: wrote runs/demo/run.h5 and runs/demo/run.xdmf (open the .xdmf in ParaView)"
+
+test: install
+	$(PY) -m pytest -q -ra tests
+
+bench: install
+	$(PY) benchmarks/run.py
+
+clean:
+	rm -rf runs .pytest_cache

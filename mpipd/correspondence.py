@@ -1,0 +1,138 @@
+"""The correspondence machinery, once for every material.
+
+:class:`Correspondence` owns the per-point kinematic state of the owned points
+— K^-1, F (this and last step), Fdot, rotation R, left stretch V, unrotated
+stress, strain energy — and the per-point force data of all local points.  It
+calls the kernels of :mod:`mpipd.kernels.nosb` and
+:mod:`mpipd.kernels.rotation`; materials only see the unrotated rate of
+deformation ``d`` and update the unrotated stress of their own points.
+
+Step order (DESIGN §4, steps 4–8)::
+
+    deform(u, v)        F, Fdot                         Eqs. 5, 13
+    rotate(dt)          R, V, d, J                      Eqs. 6–14
+    update_stress(dt)   materials, strain energy        Eq. 19 / 36
+    force_data()        B = P K^-1 - h F, h              Eqs. 2, 3, 15
+    (halo exchange of fd)
+    gather(u, f)        internal force density           Eq. 1
+    commit()            F_old <- F
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .kernels import integrate, nosb, rotation
+
+#: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
+RCOND = 1e-8
+
+
+class MaterialGroup:
+    """The owned points of one material and that material's history arrays."""
+
+    def __init__(self, material, idx: np.ndarray):
+        self.material = material
+        self.idx = idx.astype(np.int64)
+        self.state = material.new_state(len(idx))
+
+    def update(self, d, dt, sigma):
+        self.material.update(self.idx, d, dt, sigma, self.state)
+
+
+class Correspondence:
+    def __init__(self, points, families, materials: dict, material_names, hourglass: float):
+        n, nl = points.n_owned, points.n_local
+        self.points = points
+        self.families = families
+        mats = [materials[m] for m in material_names]
+        self.groups = []
+        for mid, mat in enumerate(mats):
+            idx = np.nonzero(points.material[:n] == mid)[0]
+            if len(idx):
+                self.groups.append(MaterialGroup(mat, idx))
+        eye = np.broadcast_to(np.eye(3), (n, 3, 3))
+        self.Kinv = np.zeros((n, 3, 3))
+        self.trK = np.zeros(n)
+        self.spring = np.zeros(n, dtype=np.uint8)
+        self.F = np.array(eye)
+        self.F_old = np.array(eye)
+        self.Fdot = np.zeros((n, 3, 3))
+        self.R = np.array(eye)
+        self.V = np.array(eye)
+        self.sigma = np.zeros((n, 6))           # unrotated Cauchy stress, Voigt
+        self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
+        self.J = np.ones(n)
+        self.W = np.zeros(n)                    # strain energy per reference volume
+        self.fd = np.zeros((nl, 11))            # force data, owned + ghosts
+        self.hg_modulus = np.array([hourglass * m.hourglass_modulus for m in mats])[
+            points.material[:n]]
+        # bond-spring constant 18 k / (pi delta^4) of every local point
+        bulk = np.array([m.bulk_modulus for m in mats])[points.material]
+        self.cbb = 18.0 * bulk / (math.pi * points.horizon ** 4)
+        self.n_spring = 0
+
+    # ---------------------------------------------------------------- steps
+    def rebuild_shape(self, which: np.ndarray | None = None) -> int:
+        """K^-1 of the given owned points (default: all).  Returns the number of
+        owned points on the bond-spring fallback afterwards."""
+        p, fam = self.points, self.families
+        if which is None:
+            which = np.arange(p.n_owned, dtype=np.int64)
+        nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
+                           self.Kinv, self.trK, self.spring, RCOND, which)
+        self.n_spring = int(np.count_nonzero(self.spring))
+        return self.n_spring
+
+    def deform(self, u, v):
+        p, fam = self.points, self.families
+        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr,
+                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot)
+
+    def rotate(self, dt: float):
+        rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
+                                self.spring, self.d, self.J)
+
+    def update_stress(self, dt: float):
+        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
+        for g in self.groups:
+            g.update(self.d, dt, self.sigma)
+        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
+
+    def force_data(self) -> int:
+        n_bad = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK, self.spring,
+                                self.hg_modulus, self.fd)
+        if n_bad:
+            self.n_spring = int(np.count_nonzero(self.spring))
+        return n_bad
+
+    def gather(self, u, f):
+        p, fam = self.points, self.families
+        nosb.gather_forces(p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
+                           self.fd, self.cbb, f)
+
+    def commit(self):
+        self.F_old[...] = self.F
+
+    # ---------------------------------------------------------------- diagnostics
+    def cauchy_stress(self) -> np.ndarray:
+        """Rotated Cauchy stress sigma = R S R^T of owned points, Voigt order."""
+        S = np.empty((len(self.sigma), 3, 3))
+        s = self.sigma
+        S[:, 0, 0], S[:, 1, 1], S[:, 2, 2] = s[:, 0], s[:, 1], s[:, 2]
+        S[:, 1, 2] = S[:, 2, 1] = s[:, 3]
+        S[:, 0, 2] = S[:, 2, 0] = s[:, 4]
+        S[:, 0, 1] = S[:, 1, 0] = s[:, 5]
+        T = np.einsum("nij,njk,nlk->nil", self.R, S, self.R)
+        return np.stack([T[:, 0, 0], T[:, 1, 1], T[:, 2, 2],
+                         T[:, 1, 2], T[:, 0, 2], T[:, 0, 1]], axis=1)
+
+    def strain_energy(self) -> float:
+        n = self.points.n_owned
+        return float(np.dot(self.W, self.points.volume[:n]))
+
+    def hourglass_energy(self, u) -> float:
+        p, fam = self.points, self.families
+        return nosb.hourglass_energy(p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
+                                     fam.broken, self.F, self.fd, self.spring)

@@ -1,0 +1,163 @@
+"""Slab decomposition along the thickness axis z.
+
+The model is a table of layers (:class:`mpipd.geometry.LayerTable`) in gid
+order.  :func:`decompose` cuts it into ``n`` contiguous runs of whole z levels
+with balanced point counts, so rank r owns one contiguous gid range.  A rank's
+*ghosts* are every layer it does not own whose z lies within ``halo`` of its
+own z range: ``halo = max horizon + max dx / 2`` covers the families of owned
+points and the crossing-bond rule of bond breakage (paper §2.4).
+
+A slab thinner than the halo is handled, not refused: ghosts may belong to any
+rank within reach, not just the neighbours, and the halo exchanges directly
+with each of them (see :mod:`mpipd.halo`).  Only a rank with no z level at all
+is refused.
+
+Local layout on a rank: owned points first (gid order), then ghosts (gid
+order).  Because owners hold contiguous gid ranges, the ghosts coming from one
+rank — and the owned points going to one rank — are contiguous local slices.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import LayerTable, fill_layers
+
+
+class DecompositionError(ValueError):
+    """The model cannot be split over the requested number of ranks."""
+
+
+@dataclass(frozen=True)
+class Slabs:
+    table: LayerTable
+    bounds: np.ndarray          # rank r owns layers [bounds[r], bounds[r+1])
+    halo: float
+
+    @property
+    def n_ranks(self) -> int:
+        return len(self.bounds) - 1
+
+    def owned(self, r: int) -> tuple[int, int]:
+        return int(self.bounds[r]), int(self.bounds[r + 1])
+
+    def owner_of_layer(self, layer) -> np.ndarray:
+        return np.searchsorted(self.bounds, layer, side="right") - 1
+
+    def z_range(self, r: int) -> tuple[float, float]:
+        a, b = self.owned(r)
+        return float(self.table.z[a]), float(self.table.z[b - 1])
+
+    def reach(self, r: int) -> tuple[int, int]:
+        """Layers [lo, hi) within ``halo`` of rank r's slab (its own included)."""
+        z0, z1 = self.z_range(r)
+        z = self.table.z
+        return (int(np.searchsorted(z, z0 - self.halo, side="left")),
+                int(np.searchsorted(z, z1 + self.halo, side="right")))
+
+    def ghost_layers(self, r: int) -> np.ndarray:
+        lo, hi = self.reach(r)
+        a, b = self.owned(r)
+        return np.concatenate((np.arange(lo, a), np.arange(b, hi)))
+
+    def points_of(self, r: int) -> tuple[int, int]:
+        """(owned, ghost) point counts of rank r."""
+        a, b = self.owned(r)
+        owned = int(self.table.count[a:b].sum())
+        ghost = int(self.table.count[self.ghost_layers(r)].sum())
+        return owned, ghost
+
+    def gid_range(self, r: int) -> tuple[int, int]:
+        a, b = self.owned(r)
+        return int(self.table.start[a]), int(self.table.start[a] + self.table.count[a:b].sum())
+
+    def plan(self, r: int):
+        """Halo plan of rank r: ``recv`` and ``send`` lists of (rank, start, stop)
+        local index ranges, ordered by peer rank."""
+        a, b = self.owned(r)
+        ghosts = self.ghost_layers(r)
+        counts = self.table.count
+        n_owned = int(counts[a:b].sum())
+        # local start of every ghost layer
+        gstart = n_owned + np.concatenate(([0], np.cumsum(counts[ghosts])[:-1])).astype(np.int64)
+        owner = self.owner_of_layer(ghosts)
+        recv = []
+        for q in np.unique(owner):
+            sel = np.nonzero(owner == q)[0]
+            start = int(gstart[sel[0]])
+            recv.append((int(q), start, start + int(counts[ghosts[sel]].sum())))
+        ostart = np.concatenate(([0], np.cumsum(counts[a:b]))).astype(np.int64)
+        send = []
+        for q in range(self.n_ranks):
+            if q == r:
+                continue
+            lo, hi = self.reach(q)
+            lo, hi = max(lo, a), min(hi, b)
+            if hi > lo:
+                send.append((q, int(ostart[lo - a]), int(ostart[hi - a])))
+        return recv, send
+
+
+def decompose(table: LayerTable, n_ranks: int, halo: float) -> Slabs:
+    """Split the layers into ``n_ranks`` slabs of whole z levels, balanced by points."""
+    z = table.z
+    # candidate cut positions: layer indices where z changes
+    cuts = np.nonzero(np.diff(z) > 0)[0] + 1
+    n_levels = len(cuts) + 1
+    if n_ranks > n_levels:
+        raise DecompositionError(
+            f"the model has {n_levels} z levels; {n_ranks} ranks need at least one each "
+            f"(use at most {n_levels} ranks or a finer dx)")
+    cum = np.concatenate(([0], np.cumsum(table.count)))
+    total = cum[-1]
+    bounds = [0]
+    for r in range(1, n_ranks):
+        target = total * r / n_ranks
+        # admissible cuts leave at least one level for each remaining rank
+        lo_ok = np.searchsorted(cuts, bounds[-1], side="right")
+        hi_ok = len(cuts) - (n_ranks - r - 1)
+        cand = cuts[lo_ok:hi_ok]
+        k = int(np.argmin(np.abs(cum[cand] - target)))
+        bounds.append(int(cand[k]))
+    bounds.append(len(z))
+    return Slabs(table=table, bounds=np.asarray(bounds, dtype=np.int64), halo=float(halo))
+
+
+@dataclass
+class Points:
+    """Struct of arrays of one rank's points: owned first, then ghosts, gid order in each."""
+    x: np.ndarray               # (n_local, 3) reference positions
+    gid: np.ndarray             # (n_local,) global ids
+    part: np.ndarray            # (n_local,) part index
+    material: np.ndarray        # (n_local,) material id
+    volume: np.ndarray          # (n_local,)
+    horizon: np.ndarray         # (n_local,)
+    dx: np.ndarray              # (n_local,) local lattice spacing
+    n_owned: int
+
+    @property
+    def n_local(self) -> int:
+        return len(self.gid)
+
+
+def local_points(scene, slabs: Slabs, r: int) -> Points:
+    """Generate rank r's owned and ghost points — and nothing else."""
+    a, b = slabs.owned(r)
+    layers = np.concatenate((np.arange(a, b), slabs.ghost_layers(r)))
+    x, part, gid = fill_layers(scene.parts, slabs.table, layers)
+    mid = scene.material_ids
+    dx = np.array([p.dx for p in scene.parts])[part]
+    return Points(
+        x=x, gid=gid, part=part,
+        material=np.array([mid[p.material] for p in scene.parts], dtype=np.int32)[part],
+        volume=dx ** 3,
+        horizon=np.array([p.horizon for p in scene.parts])[part],
+        dx=dx,
+        n_owned=int(slabs.table.count[a:b].sum()),
+    )
+
+
+def halo_width(scene) -> float:
+    """Ghost region depth: the largest horizon plus half the largest dx (crossing bonds)."""
+    return scene.max_horizon + 0.5 * scene.max_dx + 1e-9 * scene.max_dx

@@ -1,0 +1,167 @@
+"""Lattice fill of the scene's shapes.
+
+Every shape is a prism along z (the thickness axis, along which the model is
+decomposed into slabs).  A part is filled with a simple cubic lattice of
+spacing ``dx``: points at cell centres, so a part is the union of its points'
+cubes and every point has volume ``dx**3``.
+
+Because a shape's cross-section is the same at every z level, the model is
+described completely by a table of *layers* — one per (part, z level) — each
+knowing its point count without generating a single point.  The decomposition
+(:mod:`mpipd.decomp`) balances ranks on that table, and each rank then
+generates only the layers it owns or needs as ghosts.
+
+Within a layer, points are ordered by (y, x); global ids run over layers in
+(z, material, part) order, so gids follow (z, material, y, x).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .schema import Registry, fail, join, positive
+
+SHAPES = Registry("shape", "kind")
+
+
+def _cells(lo: float, hi: float, dx: float) -> np.ndarray:
+    """Cell-centre coordinates filling [lo, hi] with spacing dx (n = round(L/dx))."""
+    n = max(1, int(round((hi - lo) / dx)))
+    return lo + (np.arange(n) + 0.5) * dx
+
+
+def _centred(radius: float, dx: float) -> np.ndarray:
+    """Offsets ±(k + 1/2) dx covering [-radius, radius], symmetric about 0."""
+    n = int(np.ceil(radius / dx))
+    k = np.arange(-n, n) + 0.5
+    return k * dx
+
+
+def _sorted_yx(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    order = np.lexsort((x, y))
+    return x[order], y[order]
+
+
+@SHAPES.register("box")
+@dataclass(frozen=True)
+class Box:
+    """Axis-aligned box ``lo``..``hi`` (m)."""
+    lo: tuple[float, float, float]
+    hi: tuple[float, float, float]
+
+    def check(self, path):
+        for a in range(3):
+            if not self.hi[a] > self.lo[a]:
+                fail(join(path, "hi"), f"must exceed lo in every component (axis {'xyz'[a]})")
+
+    def z_levels(self, dx):
+        return _cells(self.lo[2], self.hi[2], dx)
+
+    def cross_section(self, dx):
+        xs = _cells(self.lo[0], self.hi[0], dx)
+        ys = _cells(self.lo[1], self.hi[1], dx)
+        X, Y = np.meshgrid(xs, ys, indexing="xy")    # rows = y, so ravel is (y, x) order
+        return X.ravel(), Y.ravel()
+
+
+@SHAPES.register("cylinder")
+@dataclass(frozen=True)
+class Cylinder:
+    """Solid cylinder with axis along z: ``center`` (x, y), ``radius``, ``z`` = (z0, z1)."""
+    center: tuple[float, float]
+    radius: float
+    z: tuple[float, float]
+
+    def check(self, path):
+        positive(self, path, "radius")
+        if not self.z[1] > self.z[0]:
+            fail(join(path, "z"), "z[1] must exceed z[0]")
+
+    def z_levels(self, dx):
+        return _cells(self.z[0], self.z[1], dx)
+
+    def _ring(self, dx, r_in, r_out):
+        o = _centred(r_out, dx)
+        X, Y = np.meshgrid(o, o, indexing="xy")
+        r2 = X * X + Y * Y
+        keep = (r2 <= r_out * r_out) & (r2 >= r_in * r_in)
+        return _sorted_yx(X[keep] + self.center[0], Y[keep] + self.center[1])
+
+    def cross_section(self, dx):
+        return self._ring(dx, 0.0, self.radius)
+
+
+@SHAPES.register("annulus")
+@dataclass(frozen=True)
+class Annulus(Cylinder):
+    """Hollow cylinder along z: ``center``, ``inner_radius`` < ``radius``, ``z``."""
+    inner_radius: float
+
+    def check(self, path):
+        super().check(path)
+        positive(self, path, "inner_radius")
+        if not self.inner_radius < self.radius:
+            fail(join(path, "inner_radius"), "must be smaller than radius")
+
+    def cross_section(self, dx):
+        return self._ring(dx, self.inner_radius, self.radius)
+
+
+@dataclass(frozen=True)
+class LayerTable:
+    """All layers of the model in global (z, material, part) order.
+
+    Arrays are indexed by layer: ``z``, ``part``, ``count`` and ``start`` (the
+    gid of the layer's first point).  ``n_points`` is the model's total.
+    """
+    z: np.ndarray
+    part: np.ndarray
+    count: np.ndarray
+    start: np.ndarray
+
+    @property
+    def n_points(self) -> int:
+        return int(self.start[-1] + self.count[-1]) if len(self.count) else 0
+
+    @classmethod
+    def from_parts(cls, parts, material_ids) -> "LayerTable":
+        zs, ps, ms, cs = [], [], [], []
+        for p, part in enumerate(parts):
+            z = part.shape.z_levels(part.dx)
+            n = len(part.shape.cross_section(part.dx)[0])
+            zs.append(z)
+            ps.append(np.full(len(z), p))
+            ms.append(np.full(len(z), material_ids[part.material]))
+            cs.append(np.full(len(z), n))
+        z, part, mat, count = (np.concatenate(a) for a in (zs, ps, ms, cs))
+        order = np.lexsort((part, mat, z))
+        count = count[order].astype(np.int64)
+        start = np.concatenate(([0], np.cumsum(count)[:-1])).astype(np.int64)
+        return cls(z=z[order], part=part[order], count=count, start=start)
+
+
+def fill_layers(parts, table: LayerTable, layers: np.ndarray):
+    """Generate the points of the given layers (in the given order).
+
+    Returns ``x`` (n, 3) reference positions, ``part`` (n,) part index and
+    ``gid`` (n,) global ids.
+    """
+    sections = {}
+    xs, ps, gs = [], [], []
+    for L in layers:
+        p = int(table.part[L])
+        if p not in sections:
+            sections[p] = parts[p].shape.cross_section(parts[p].dx)
+        sx, sy = sections[p]
+        n = len(sx)
+        x = np.empty((n, 3))
+        x[:, 0] = sx
+        x[:, 1] = sy
+        x[:, 2] = table.z[L]
+        xs.append(x)
+        ps.append(np.full(n, p, dtype=np.int32))
+        gs.append(table.start[L] + np.arange(n, dtype=np.int64))
+    if not xs:
+        return np.empty((0, 3)), np.empty(0, np.int32), np.empty(0, np.int64)
+    return np.concatenate(xs), np.concatenate(ps), np.concatenate(gs)

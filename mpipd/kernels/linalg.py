@@ -1,0 +1,72 @@
+"""3x3 matrix helpers for per-point kernels (inlined by numba)."""
+import numba
+
+
+@numba.njit(cache=True, inline="always")
+def det3(a):
+    return (a[0, 0] * (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1])
+            - a[0, 1] * (a[1, 0] * a[2, 2] - a[1, 2] * a[2, 0])
+            + a[0, 2] * (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]))
+
+
+@numba.njit(cache=True, inline="always")
+def inv3(a, out):
+    """out = a^-1; returns det(a).  ``out`` must not alias ``a``."""
+    d = det3(a)
+    s = 1.0 / d
+    out[0, 0] = (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]) * s
+    out[0, 1] = (a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]) * s
+    out[0, 2] = (a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]) * s
+    out[1, 0] = (a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]) * s
+    out[1, 1] = (a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]) * s
+    out[1, 2] = (a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]) * s
+    out[2, 0] = (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]) * s
+    out[2, 1] = (a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]) * s
+    out[2, 2] = (a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]) * s
+    return d
+
+
+@numba.njit(cache=True, inline="always")
+def mul3(a, b, out):
+    """out = a b."""
+    for r in range(3):
+        for c in range(3):
+            out[r, c] = a[r, 0] * b[0, c] + a[r, 1] * b[1, c] + a[r, 2] * b[2, c]
+
+
+@numba.njit(cache=True, inline="always")
+def mul3_bt(a, b, out):
+    """out = a b^T."""
+    for r in range(3):
+        for c in range(3):
+            out[r, c] = a[r, 0] * b[c, 0] + a[r, 1] * b[c, 1] + a[r, 2] * b[c, 2]
+
+
+@numba.njit(cache=True, inline="always")
+def mul3_at(a, b, out):
+    """out = a^T b."""
+    for r in range(3):
+        for c in range(3):
+            out[r, c] = a[0, r] * b[0, c] + a[1, r] * b[1, c] + a[2, r] * b[2, c]
+
+
+@numba.njit(cache=True, inline="always")
+def voigt_to_mat(s, out):
+    """Symmetric tensor from Voigt order (xx, yy, zz, yz, xz, xy)."""
+    out[0, 0] = s[0]
+    out[1, 1] = s[1]
+    out[2, 2] = s[2]
+    out[1, 2] = out[2, 1] = s[3]
+    out[0, 2] = out[2, 0] = s[4]
+    out[0, 1] = out[1, 0] = s[5]
+
+
+@numba.njit(cache=True, inline="always")
+def mat_to_voigt(m, out):
+    """Voigt order (xx, yy, zz, yz, xz, xy) of the symmetric part of m."""
+    out[0] = m[0, 0]
+    out[1] = m[1, 1]
+    out[2] = m[2, 2]
+    out[3] = 0.5 * (m[1, 2] + m[2, 1])
+    out[4] = 0.5 * (m[0, 2] + m[2, 0])
+    out[5] = 0.5 * (m[0, 1] + m[1, 0])

@@ -1,0 +1,288 @@
+"""Correspondence (non-ordinary state-based) kernels, gather form.
+
+Notation (paper §2.1): xi = x_j - x_i (reference bond), Y = xi + u_j - u_i
+(deformed bond), omega_i = (delta_i - |xi|)^2 for |xi| < delta_i, else 0.
+
+* Shape tensor (Eq. 4):    K_i = sum_j omega_i xi (x) xi V_j
+* Deformation gradient (Eq. 5) and its rate (Eq. 13):
+      F_i = [sum_j omega_i Y (x) xi V_j] K_i^-1,  Fdot_i = [sum_j omega_i Ydot (x) xi V_j] K_i^-1
+* Force state (Eq. 2) with P = J sigma F^-T (Eq. 3 corrected, see DESIGN §6):
+      T_i<xi> = omega_i A_i xi,  A_i = P_i K_i^-1
+* Hourglass penalty (Eq. 15), made dimensionally consistent and conservative:
+      T^hg_i<xi> = omega_i h_i (Y - F_i xi),  h_i = 2 c M / tr(K_i)
+  with M a material modulus (the shear modulus) and c the scene's coefficient.
+  It is the gradient of the energy  E_hg = sum_i V_i (h_i / 2) sum_j omega_i |Y - F_i xi|^2 V_j;
+  since F_i is the omega-weighted least-squares fit of Y, dE/dF_i = 0 and the
+  force is exactly this state.  Affine fields feel no penalty (Y = F xi).
+* The pair force density on owned point i (Eq. 1) is gathered, never scattered:
+      f_i = sum_j (T_i<xi_ij> - T_j<xi_ji>) V_j
+          = sum_j [omega_i (B_i xi + h_i Y) + omega_j (B_j xi + h_j Y)] V_j,
+  with the per-point force data B = A - h F, h and the fallback flag, which
+  the owner of every ghost computes and the halo copies — 11 numbers a point.
+* Bond-spring fallback (paper §2.1) where K (too few intact bonds) or F
+  (J <= 0) cannot be inverted: that side of the bond acts as a bond-based
+  spring, T = (c_bb / 2) s Y/|Y| with s = |Y|/|xi| - 1 and c_bb = 18 k / (pi delta^4).
+"""
+import math
+
+import numba
+import numpy as np
+
+from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
+
+
+@numba.njit(cache=True)
+def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcond, points):
+    """K^-1 and tr K for the owned points listed in ``points``.
+
+    A point with fewer than 3 intact bonds, or with det K <= rcond (tr K / 3)^3,
+    is marked ``spring[i] = 1`` (bond-spring fallback).  Returns how many are.
+    """
+    K = np.empty((3, 3))
+    n_spring = 0
+    for p in range(points.shape[0]):
+        i = points[p]
+        k00 = k01 = k02 = k11 = k12 = k22 = 0.0
+        nb = 0
+        di = horizon[i]
+        for b in range(offsets[i], offsets[i + 1]):
+            if broken[b]:
+                continue
+            j = nbr[b]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            w = di - r
+            w = w * w * vol[j]
+            k00 += w * e0 * e0
+            k01 += w * e0 * e1
+            k02 += w * e0 * e2
+            k11 += w * e1 * e1
+            k12 += w * e1 * e2
+            k22 += w * e2 * e2
+            nb += 1
+        K[0, 0] = k00
+        K[1, 1] = k11
+        K[2, 2] = k22
+        K[0, 1] = K[1, 0] = k01
+        K[0, 2] = K[2, 0] = k02
+        K[1, 2] = K[2, 1] = k12
+        tr = k00 + k11 + k22
+        trK[i] = tr
+        d = det3(K)
+        if nb < 3 or not d > rcond * (tr / 3.0) ** 3:
+            spring[i] = 1
+            n_spring += 1
+            for r_ in range(3):
+                for c in range(3):
+                    Kinv[i, r_, c] = 0.0
+        else:
+            spring[i] = 0
+            inv3(K, Kinv[i])
+    return n_spring
+
+
+@numba.njit(cache=True)
+def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spring, F, Fdot):
+    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v."""
+    n = offsets.shape[0] - 1
+    N = np.empty((3, 3))
+    Nd = np.empty((3, 3))
+    for i in range(n):
+        if spring[i]:
+            for r in range(3):
+                for c in range(3):
+                    F[i, r, c] = 1.0 if r == c else 0.0
+                    Fdot[i, r, c] = 0.0
+            continue
+        n00 = n01 = n02 = n10 = n11 = n12 = n20 = n21 = n22 = 0.0
+        m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
+        xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
+        ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
+        vi0, vi1, vi2 = v[i, 0], v[i, 1], v[i, 2]
+        di = horizon[i]
+        for b in range(offsets[i], offsets[i + 1]):
+            if broken[b]:
+                continue
+            j = nbr[b]
+            e0 = x[j, 0] - xi0
+            e1 = x[j, 1] - xi1
+            e2 = x[j, 2] - xi2
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            w = di - r
+            w = w * w * vol[j]
+            y0 = e0 + (u[j, 0] - ui0)
+            y1 = e1 + (u[j, 1] - ui1)
+            y2 = e2 + (u[j, 2] - ui2)
+            z0 = w * (v[j, 0] - vi0)
+            z1 = w * (v[j, 1] - vi1)
+            z2 = w * (v[j, 2] - vi2)
+            y0 *= w
+            y1 *= w
+            y2 *= w
+            n00 += y0 * e0
+            n01 += y0 * e1
+            n02 += y0 * e2
+            n10 += y1 * e0
+            n11 += y1 * e1
+            n12 += y1 * e2
+            n20 += y2 * e0
+            n21 += y2 * e1
+            n22 += y2 * e2
+            m00 += z0 * e0
+            m01 += z0 * e1
+            m02 += z0 * e2
+            m10 += z1 * e0
+            m11 += z1 * e1
+            m12 += z1 * e2
+            m20 += z2 * e0
+            m21 += z2 * e1
+            m22 += z2 * e2
+        N[0, 0], N[0, 1], N[0, 2] = n00, n01, n02
+        N[1, 0], N[1, 1], N[1, 2] = n10, n11, n12
+        N[2, 0], N[2, 1], N[2, 2] = n20, n21, n22
+        Nd[0, 0], Nd[0, 1], Nd[0, 2] = m00, m01, m02
+        Nd[1, 0], Nd[1, 1], Nd[1, 2] = m10, m11, m12
+        Nd[2, 0], Nd[2, 1], Nd[2, 2] = m20, m21, m22
+        mul3(N, Kinv[i], F[i])
+        mul3(Nd, Kinv[i], Fdot[i])
+
+
+@numba.njit(cache=True)
+def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
+    """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
+    fd[i, 9] = h, fd[i, 10] = 1.0 for a bond-spring point, else 0.0, with A = J sigma F^-T K^-1, sigma = R sigma_unrot R^T, h = 2 M / tr K.
+
+    ``hg_modulus[i]`` is c * M of the point's material.  Points whose K or F
+    cannot be inverted switch to the bond-spring fallback (``spring[i] = 1``).
+    Returns the number of points whose F turned singular this call.
+    """
+    n_owned = F.shape[0]
+    S = np.empty((3, 3))
+    T1 = np.empty((3, 3))
+    T2 = np.empty((3, 3))
+    Finv = np.empty((3, 3))
+    P = np.empty((3, 3))
+    n_bad = 0
+    for i in range(n_owned):
+        if spring[i] == 0:
+            J = det3(F[i])
+            if not J > 0.0:
+                spring[i] = 2          # singular F this step
+                n_bad += 1
+        if spring[i]:
+            for c in range(10):
+                fd[i, c] = 0.0
+            fd[i, 10] = 1.0
+            continue
+        voigt_to_mat(sigma[i], S)
+        mul3(R[i], S, T1)
+        mul3_bt(T1, R[i], T2)          # sigma = R S R^T
+        J = inv3(F[i], Finv)
+        mul3_bt(T2, Finv, T1)          # sigma F^-T
+        for r in range(3):
+            for c in range(3):
+                P[r, c] = J * T1[r, c]
+        mul3(P, Kinv[i], T1)           # A = P K^-1
+        h = 2.0 * hg_modulus[i] / trK[i]
+        for r in range(3):
+            for c in range(3):
+                fd[i, 3 * r + c] = T1[r, c] - h * F[i, r, c]
+        fd[i, 9] = h
+        fd[i, 10] = 0.0
+    return n_bad
+
+
+@numba.njit(cache=True)
+def gather_forces(x, u, vol, horizon, offsets, nbr, broken, fd, cbb, f):
+    """Internal force density f (N/m^3) of every owned point (see module docstring)."""
+    n = offsets.shape[0] - 1
+    for i in range(n):
+        xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
+        ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
+        b0, b1, b2 = fd[i, 0], fd[i, 1], fd[i, 2]
+        b3, b4, b5 = fd[i, 3], fd[i, 4], fd[i, 5]
+        b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
+        hi = fd[i, 9]
+        di = horizon[i]
+        si = fd[i, 10]
+        fx = fy = fz = 0.0
+        for k in range(offsets[i], offsets[i + 1]):
+            if broken[k]:
+                continue
+            j = nbr[k]
+            e0 = x[j, 0] - xi0
+            e1 = x[j, 1] - xi1
+            e2 = x[j, 2] - xi2
+            y0 = e0 + (u[j, 0] - ui0)
+            y1 = e1 + (u[j, 1] - ui1)
+            y2 = e2 + (u[j, 2] - ui2)
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            tx = ty = tz = 0.0
+            if si == 0.0:
+                w = di - r
+                w = w * w
+                tx = w * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
+                ty = w * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
+                tz = w * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
+            else:
+                g = _spring(cbb[i], r, y0, y1, y2)
+                tx, ty, tz = g * y0, g * y1, g * y2
+            dj = horizon[j]
+            if r < dj:
+                if fd[j, 10] == 0.0:
+                    w = dj - r
+                    w = w * w
+                    tx += w * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)
+                    ty += w * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, 9] * y1)
+                    tz += w * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, 9] * y2)
+                else:
+                    g = _spring(cbb[j], r, y0, y1, y2)
+                    tx += g * y0
+                    ty += g * y1
+                    tz += g * y2
+            vj = vol[j]
+            fx += tx * vj
+            fy += ty * vj
+            fz += tz * vj
+        f[i, 0] = fx
+        f[i, 1] = fy
+        f[i, 2] = fz
+
+
+@numba.njit(cache=True, inline="always")
+def _spring(c, r, y0, y1, y2):
+    """Half a bond-based spring: (c/2) (|Y|/r - 1) / |Y|, to multiply Y."""
+    ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+    if ly == 0.0:
+        return 0.0
+    return 0.5 * c * (ly / r - 1.0) / ly
+
+
+@numba.njit(cache=True)
+def hourglass_energy(x, u, vol, horizon, offsets, nbr, broken, F, fd, spring):
+    """E_hg = sum_i V_i (h_i / 2) sum_j omega_i |Y - F_i xi|^2 V_j over owned points."""
+    n = offsets.shape[0] - 1
+    total = 0.0
+    for i in range(n):
+        if spring[i]:
+            continue
+        di = horizon[i]
+        acc = 0.0
+        for k in range(offsets[i], offsets[i + 1]):
+            if broken[k]:
+                continue
+            j = nbr[k]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            w = di - r
+            w = w * w
+            z0 = e0 + u[j, 0] - u[i, 0] - (F[i, 0, 0] * e0 + F[i, 0, 1] * e1 + F[i, 0, 2] * e2)
+            z1 = e1 + u[j, 1] - u[i, 1] - (F[i, 1, 0] * e0 + F[i, 1, 1] * e1 + F[i, 1, 2] * e2)
+            z2 = e2 + u[j, 2] - u[i, 2] - (F[i, 2, 0] * e0 + F[i, 2, 1] * e1 + F[i, 2, 2] * e2)
+            acc += w * (z0 * z0 + z1 * z1 + z2 * z2) * vol[j]
+        total += vol[i] * 0.5 * fd[i, 9] * acc
+    return total

@@ -1,0 +1,81 @@
+"""Initial conditions and boundary conditions, resolved through registries.
+
+Initial conditions set the velocity field at t = 0 on the reference
+positions; boundary conditions mark points whose motion is prescribed.  Each
+entry of a scene's ``[[initial]]`` / ``[[boundaries]]`` arrays names its
+``kind``; adding a kind means registering one small dataclass here.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .schema import Registry, fail, join, positive
+
+INITIAL = Registry("initial condition", "kind")
+BOUNDARIES = Registry("boundary condition", "kind")
+
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+@dataclass(frozen=True)
+class Region:
+    """Axis-aligned box region ``lo``..``hi`` (m), bounds inclusive."""
+    lo: tuple[float, float, float]
+    hi: tuple[float, float, float]
+
+    def check(self, path):
+        for a in range(3):
+            if self.hi[a] < self.lo[a]:
+                fail(join(path, "hi"), f"must not be below lo (axis {'xyz'[a]})")
+
+    def contains(self, x: np.ndarray) -> np.ndarray:
+        lo, hi = np.asarray(self.lo), np.asarray(self.hi)
+        return np.all((x >= lo) & (x <= hi), axis=1)
+
+
+@INITIAL.register("velocity_pulse")
+@dataclass(frozen=True)
+class VelocityPulse:
+    """v = velocity * cos²(π s / (2 w)) for |s| < w, s = x[axis] − center, w = half_width.
+
+    Centred on a free end (``center`` at the end face), the pulse is half of a
+    symmetric bump and launches one wave of peak ``velocity / 2`` into the body.
+    """
+    axis: str
+    center: float
+    half_width: float
+    velocity: tuple[float, float, float]
+
+    def check(self, path):
+        if self.axis not in AXES:
+            fail(join(path, "axis"), f"must be one of x, y, z (got {self.axis!r})")
+        positive(self, path, "half_width")
+
+    def apply(self, x: np.ndarray, v: np.ndarray) -> None:
+        s = x[:, AXES[self.axis]] - self.center
+        inside = np.abs(s) < self.half_width
+        shape = np.cos(0.5 * np.pi * s[inside] / self.half_width) ** 2
+        v[inside] += shape[:, None] * np.asarray(self.velocity)[None, :]
+
+
+@INITIAL.register("uniform_velocity")
+@dataclass(frozen=True)
+class UniformVelocity:
+    """v = ``velocity`` for every point inside ``region``."""
+    region: Region
+    velocity: tuple[float, float, float]
+
+    def apply(self, x: np.ndarray, v: np.ndarray) -> None:
+        v[self.region.contains(x)] += np.asarray(self.velocity)
+
+
+@BOUNDARIES.register("fixed")
+@dataclass(frozen=True)
+class Fixed:
+    """Points inside ``region`` are held at their reference position (u = v = 0)."""
+    region: Region
+
+    def mask(self, x: np.ndarray) -> np.ndarray:
+        return self.region.contains(x)

@@ -1,0 +1,28 @@
+"""Constitutive models, one per module, behind one small interface.
+
+A material is a frozen dataclass of its scene parameters, registered in
+:data:`MATERIALS` under the name a scene's ``model`` key selects.  The
+correspondence machinery (:mod:`mpipd.correspondence`) computes F, the rotation
+R, the left stretch V and the *unrotated* rate of deformation d for every point;
+a material only turns d and its own history into the unrotated Cauchy stress.
+
+Interface (see :class:`mpipd.materials.base.Material`):
+
+``density``, ``bulk_modulus``, ``shear_modulus``
+    reference properties (used for the stable time step, the hourglass
+    stiffness and the bond-spring fallback);
+``new_state(n)``
+    the material's history arrays for its ``n`` owned points (a dict; empty for
+    elastic) — they exist only for points of this material;
+``update(idx, d, dt, sigma, state)``
+    advance the unrotated stress ``sigma[idx]`` (Voigt order xx, yy, zz, yz,
+    xz, xy) by one step from ``d[idx]``;
+``exchanged``
+    names of per-point fields the material needs in the halo besides the
+    correspondence data (none for elastic).
+"""
+from ..schema import Registry
+
+MATERIALS = Registry("material model", "model")
+
+from . import elastic  # noqa: E402,F401  (registers)

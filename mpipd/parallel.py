@@ -1,0 +1,58 @@
+"""The communicator, passed in — never a global.
+
+:class:`Team` wraps an mpi4py communicator with the few collective verbs the
+solver needs (reductions, broadcast, abort).  Nothing here initialises MPI at
+import; :func:`world` imports ``mpi4py.MPI`` only when called.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+class Team:
+    """The ranks of one run and their collective operations."""
+
+    def __init__(self, comm):
+        self.comm = comm
+        self.rank = comm.Get_rank()
+        self.size = comm.Get_size()
+
+    @property
+    def root(self) -> bool:
+        return self.rank == 0
+
+    def _op(self, name):
+        from mpi4py import MPI
+        return getattr(MPI, name)
+
+    def sum(self, x):
+        """Global sum of a number or of a NumPy array (elementwise)."""
+        if np.isscalar(x):
+            return self.comm.allreduce(x, op=self._op("SUM"))
+        out = np.empty_like(x)
+        self.comm.Allreduce(np.ascontiguousarray(x), out, op=self._op("SUM"))
+        return out
+
+    def max(self, x):
+        return self.comm.allreduce(x, op=self._op("MAX"))
+
+    def min(self, x):
+        return self.comm.allreduce(x, op=self._op("MIN"))
+
+    def gather(self, x):
+        """Small per-rank values to every rank (a list indexed by rank)."""
+        return self.comm.allgather(x)
+
+    def bcast(self, x):
+        return self.comm.bcast(x, root=0)
+
+    def barrier(self):
+        self.comm.Barrier()
+
+    def abort(self, code: int = 1):
+        self.comm.Abort(code)
+
+
+def world() -> Team:
+    from mpi4py import MPI
+    return Team(MPI.COMM_WORLD)

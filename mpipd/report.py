@@ -1,0 +1,93 @@
+"""``mpipd check``: sizes, memory, halo and stable time step of a scene, without running it.
+
+Nothing here generates the model's points: counts come from the layer table
+and each part's bulk family (the lattice offsets within the horizon), so a
+check of the paper's 1.65-million-point model takes a moment on a laptop.
+
+Stable time step.  Two estimates per part, and the scene's dt against the smaller:
+
+* Silling & Askari (2005), bond-based bound for a bulk point:
+  dt_c = sqrt(2 rho / sum_j V_j c / |xi_j|), c = 18 K / (pi delta^4);
+* the P-wave transit of one lattice spacing, dx / sqrt((K + 4G/3) / rho).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .decomp import decompose, halo_width
+from .geometry import LayerTable
+
+#: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
+#: allocates (``tests/test_memory.py`` checks it)
+BYTES_PER_LOCAL_POINT = 208     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb
+BYTES_PER_OWNED_POINT = 634     # a, f, rho, fixed, offsets, K^-1, tr K, spring, F, F_old,
+#                                 Fdot, R, V, sigma, d, J, W, hourglass modulus, group index
+BYTES_PER_BOND = 5              # nbr (int32) + broken (uint8)
+
+
+def bulk_family(dx: float, horizon: float) -> np.ndarray:
+    """Bond lengths |xi| of a bulk lattice point's family."""
+    n = int(math.ceil(horizon / dx))
+    k = np.arange(-n, n + 1)
+    I, J, K = np.meshgrid(k, k, k, indexing="ij")
+    r = dx * np.sqrt(I * I + J * J + K * K).ravel()
+    return r[(r > 0) & (r < horizon)]
+
+
+def stable_dt(part, material) -> tuple[float, float]:
+    """(Silling–Askari dt, dx / c_p) for a bulk point of ``part``."""
+    r = bulk_family(part.dx, part.horizon)
+    c = 18.0 * material.bulk_modulus / (math.pi * part.horizon ** 4)
+    dt_sa = math.sqrt(2.0 * material.density / np.sum(part.dx ** 3 * c / r))
+    return dt_sa, part.dx / material.p_wave_speed
+
+
+def check_report(scene, ranks: int) -> str:
+    table = LayerTable.from_parts(scene.parts, scene.material_ids)
+    halo = halo_width(scene)
+    slabs = decompose(table, ranks, halo)
+    out = [f"scene {scene.name!r}: {scene.scene.description}".rstrip(": ")]
+    out.append(f"  steps: {scene.time.n_steps} of dt = {scene.time.dt:.4e} s "
+               f"(t_end = {scene.time.n_steps * scene.time.dt:.4e} s)")
+    total_bonds = 0
+    family = {}
+    dt_limits = []
+    for k, p in enumerate(scene.parts):
+        npts = int(table.count[table.part == k].sum())
+        fam = len(bulk_family(p.dx, p.horizon))
+        family[k] = fam
+        total_bonds += npts * fam
+        mat = scene.materials[p.material]
+        dt_sa, dt_cfl = stable_dt(p, mat)
+        dt_limits.append(min(dt_sa, dt_cfl))
+        out.append(f"  part {p.name!r}: {p.shape.registry_name}, material {p.material!r} "
+                   f"({mat.registry_name}), dx = {p.dx:.4g} m, horizon = {p.horizon:.4g} m "
+                   f"({p.horizon_factor:g} dx), {npts} points, {fam} bonds per bulk point")
+        out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
+                   f"(c_p = {mat.p_wave_speed:.1f} m/s)")
+    out.append(f"  total: {table.n_points} points, <= {total_bonds} bonds "
+               f"(bulk families; surface points have fewer)")
+    dt_max = min(dt_limits)
+    verdict = "OK" if scene.time.dt <= dt_max else "TOO LARGE - the run will be unstable"
+    out.append(f"  time step: dt = {scene.time.dt:.4e} s vs stable {dt_max:.4e} s "
+               f"(ratio {scene.time.dt / dt_max:.2f}): {verdict}")
+    out.append(f"  decomposition: {ranks} rank(s) along z, halo = {halo:.4g} m "
+               "(largest horizon + dx/2)")
+    for r in range(ranks):
+        owned, ghost = slabs.points_of(r)
+        z0, z1 = slabs.z_range(r)
+        a, b = slabs.owned(r)
+        layers = np.arange(a, b)
+        bonds = int(sum(table.count[L] * family[int(table.part[L])] for L in layers))
+        mem = (BYTES_PER_LOCAL_POINT * (owned + ghost) + BYTES_PER_OWNED_POINT * owned
+               + BYTES_PER_BOND * bonds)
+        thick = z1 - z0 + float(scene.max_dx)
+        recv, _ = slabs.plan(r)
+        peers = len(recv)
+        hop = " (thinner than the halo: multi-hop exchange)" if thick < halo and ranks > 1 else ""
+        out.append(f"    rank {r}: z {z0:.4g}..{z1:.4g} m ({thick:.4g} m thick), {owned} owned + "
+                   f"{ghost} ghost points, <= {bonds} bonds, ~{mem / 2**20:.1f} MiB, "
+                   f"{peers} halo peer(s){hop}")
+    return "\n".join(out)

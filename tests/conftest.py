@@ -1,0 +1,67 @@
+"""Shared test helpers.
+
+Serial tests run the solver in-process on a one-rank communicator; MPI tests
+run the CLI or a script under ``mpirun`` with a timeout, so a deadlock fails
+instead of hanging.
+"""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+os.environ.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
+
+import pytest  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+
+
+def granite(**kw):
+    d = {"model": "elastic", "density": 2660.0, "bulk_modulus": 21.9e9, "shear_modulus": 25.7e9}
+    d.update(kw)
+    return d
+
+
+def scene_dict(shape, dx=1e-3, dt=5e-8, steps=10, hourglass=0.01, initial=(), boundaries=(),
+               parts=None, **extra):
+    d = {
+        "scene": {"name": "test"},
+        "time": {"dt": dt, "steps": steps},
+        "materials": {"granite": granite()},
+        "parts": parts or [{"name": "p", "material": "granite", "dx": dx, "shape": shape}],
+        "solver": {"hourglass": hourglass},
+        "initial": list(initial),
+        "boundaries": list(boundaries),
+    }
+    d.update(extra)
+    return d
+
+
+def make_scene(d):
+    from mpipd.schema import build
+    from mpipd.scene import Scene
+    return build(Scene, d)
+
+
+@pytest.fixture(scope="session")
+def team():
+    from mpi4py import MPI
+
+    from mpipd.parallel import Team
+    return Team(MPI.COMM_SELF)
+
+
+def run_cli(args, ranks=None, timeout=300, cwd=None):
+    """Run ``mpipd ARGS`` (under ``mpirun -n ranks`` if given); returns CompletedProcess."""
+    cmd = [str(BIN / "mpipd"), *args]
+    if ranks is not None:
+        cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), *cmd]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd)
+
+
+def run_mpi_script(script, ranks, *args, timeout=300):
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(script), *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
