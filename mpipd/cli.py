@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import traceback
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
@@ -95,18 +94,9 @@ def cmd_check(args) -> int:
 
 def cmd_run(args) -> int:
     os.environ.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    from .parallel import world
+    from .parallel import abort_on_error, world
     team = world()
-    try:
-        return _run(args, team)
-    except SystemExit:
-        raise
-    except BaseException:
-        sys.stderr.write(f"mpipd: rank {team.rank} failed:\n{traceback.format_exc()}")
-        sys.stderr.flush()
-        if team.size > 1:
-            team.abort(1)
-        return 1
+    return abort_on_error(team, _run, args, team)
 
 
 def _bad_input(team, exc) -> int:

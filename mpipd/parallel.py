@@ -53,6 +53,23 @@ class Team:
         self.comm.Abort(code)
 
 
+def abort_on_error(team: Team, fn, *args):
+    """Run ``fn(*args)``; if it raises on any rank, print the traceback and abort
+    the whole MPI job (a plain exit would leave the other ranks waiting forever)."""
+    import sys
+    import traceback
+    try:
+        return fn(*args)
+    except SystemExit:
+        raise
+    except BaseException:
+        sys.stderr.write(f"mpipd: rank {team.rank} failed:\n{traceback.format_exc()}")
+        sys.stderr.flush()
+        if team.size > 1:
+            team.abort(1)
+        return 1
+
+
 def world() -> Team:
     from mpi4py import MPI
     return Team(MPI.COMM_WORLD)

@@ -79,7 +79,10 @@ class Simulation:
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
         self.step_count = 0
         self.t = 0.0
-        # initial state: F from the initial displacement, forces from it
+        self.initialize()
+
+    def initialize(self):
+        """F from the current (initial) displacement and the forces it gives."""
         self.halo.exchange(self.u, self.v)
         self.corr.deform(self.u, self.v)
         self.corr.commit()

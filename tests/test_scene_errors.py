@@ -1,0 +1,79 @@
+"""Bad input: one clear line naming what is wrong, exit status 2, nothing written."""
+import pytest
+from conftest import run_cli
+
+from mpipd import scene as sc
+
+CASES = [
+    (["--set", "parts.0.radus=1"], "parts[0].radus", "unknown key"),
+    (["--set", 'parts.0.dx="abc"'], "parts[0].dx", "expected a number"),
+    (["--set", "parts.0.dx=-0.001"], "parts[0].dx", "must be > 0"),
+    (["--set", "parts.0.horizon_factor=0.5"], "parts[0].horizon_factor", "at least dx"),
+    (["--set", "time.steps=10"], "time.steps", "exactly one of steps and t_end"),
+    (["--set", "materials.granite.model=rubber"], "materials.granite.model", "unknown material"),
+    (["--set", "parts.0.material=basalt"], "parts[0].material", "no material"),
+    (["--set", "output.fields=[\"u\",\"temperature\"]"], "output.fields[1]", "unknown field"),
+    (["--set", "initial.0.axis=w"], "initial[0].axis", "must be one of"),
+    (["--set", "time.dt=true"], "time.dt", "expected a number"),
+]
+
+
+def check_bad(res, out, *needles, mpirun=False):
+    assert res.returncode == 2, res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    if mpirun:                       # mpirun adds its own banner around ours
+        lines = [ln for ln in lines if ln.startswith("mpipd")]
+    assert len(lines) == 1, res.stderr
+    assert lines[0].startswith("mpipd: error: ")
+    for n in needles:
+        assert n in lines[0], lines[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("args,key,reason", CASES)
+def test_bad_override(tmp_path, args, key, reason):
+    out = tmp_path / "out"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *args])
+    check_bad(res, out, key, reason)
+
+
+def test_missing_value(tmp_path):
+    text = sc.builtin_scenes()["elastic_wave"].read_text().replace("dx = 1.0e-3\n", "")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", str(f), "--out", str(out)]), out, "parts[0].dx", "missing value")
+
+
+def test_not_toml(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text("this is [not toml\n")
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", str(f), "--out", str(out)]), out, str(f), "not a valid TOML")
+
+
+def test_unknown_scene(tmp_path):
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", "no_such_scene", "--out", str(out)]), out, "no_such_scene",
+              "elastic_wave")
+
+
+def test_check_reports_bad_scene_too(tmp_path):
+    res = run_cli(["check", "elastic_wave", "--set", "parts.0.dx=-1"])
+    assert res.returncode == 2 and "parts[0].dx: must be > 0" in res.stderr
+
+
+def test_existing_output_is_not_overwritten(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "run.h5").write_bytes(b"precious")
+    res = run_cli(["run", "elastic_wave", "--out", str(out)])
+    assert res.returncode == 2 and "exists" in res.stderr and "--overwrite" in res.stderr
+    assert (out / "run.h5").read_bytes() == b"precious"
+
+
+def test_bad_scene_under_mpirun_one_message(tmp_path):
+    out = tmp_path / "out"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), "--set", "parts.0.dx=0"],
+                  ranks=2, timeout=120)
+    check_bad(res, out, "parts[0].dx", "must be > 0", mpirun=True)
