@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -38,26 +39,53 @@ class Families:
         return np.diff(self.offsets)
 
 
+@numba.njit(cache=True)
+def _csr_by_row(i, j, gid, n_rows):
+    """Counting sort of pairs (i, j) by row i, then each row by gid[j] (insertion
+    sort: a family is ~100 entries).  Returns (row counts, nbr)."""
+    counts = np.zeros(n_rows, np.int64)
+    for k in range(i.shape[0]):
+        counts[i[k]] += 1
+    start = np.zeros(n_rows + 1, np.int64)
+    for r in range(n_rows):
+        start[r + 1] = start[r] + counts[r]
+    fill = start[:-1].copy()
+    nbr = np.empty(i.shape[0], np.int32)
+    for k in range(i.shape[0]):
+        nbr[fill[i[k]]] = j[k]
+        fill[i[k]] += 1
+    for r in range(n_rows):
+        for a in range(start[r] + 1, start[r + 1]):
+            v = nbr[a]
+            g = gid[v]
+            b = a - 1
+            while b >= start[r] and gid[nbr[b]] > g:
+                nbr[b + 1] = nbr[b]
+                b -= 1
+            nbr[b + 1] = v
+    return counts, nbr
+
+
 def build_families(x: np.ndarray, gid: np.ndarray, horizon: np.ndarray, n_owned: int,
-                   chunk: int = 65536) -> Families:
-    """Families of the first ``n_owned`` points among all ``len(x)`` local points."""
+                   chunk: int = 16384) -> Families:
+    """Families of the first ``n_owned`` points among all ``len(x)`` local points.
+
+    Owned points are processed in chunks, so the pair temporaries stay at
+    ``chunk`` families whatever the model size."""
     tree = cKDTree(x)
-    rows, cols = [], []
+    counts, nbrs = [], []
     for s in range(0, n_owned, chunk):
         e = min(n_owned, s + chunk)
         sub = cKDTree(x[s:e])
-        # neighbours of chunk points within their (largest) horizon
         m = sub.sparse_distance_matrix(tree, float(horizon[s:e].max()), output_type="ndarray")
-        i = m["i"].astype(np.int64) + s
-        j = m["j"].astype(np.int64)
-        keep = (m["v"] < horizon[i]) & (i != j)
-        rows.append(i[keep])
-        cols.append(j[keep])
-    i = np.concatenate(rows) if rows else np.empty(0, np.int64)
-    j = np.concatenate(cols) if cols else np.empty(0, np.int64)
-    order = np.lexsort((gid[j], i))
-    i, j = i[order], j[order]
+        i = m["i"]
+        j = m["j"]
+        keep = (m["v"] < horizon[i + s]) & (i + s != j)
+        c, nb = _csr_by_row(i[keep], j[keep], gid, e - s)
+        counts.append(c)
+        nbrs.append(nb)
     offsets = np.zeros(n_owned + 1, dtype=np.int64)
-    np.cumsum(np.bincount(i, minlength=n_owned), out=offsets[1:])
-    return Families(offsets=offsets, nbr=j.astype(np.int32),
-                    broken=np.zeros(len(j), dtype=np.uint8))
+    if counts:
+        np.cumsum(np.concatenate(counts), out=offsets[1:])
+    nbr = np.concatenate(nbrs) if nbrs else np.empty(0, np.int32)
+    return Families(offsets=offsets, nbr=nbr, broken=np.zeros(len(nbr), dtype=np.uint8))

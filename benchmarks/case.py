@@ -1,0 +1,76 @@
+"""One benchmark case, run under mpirun by benchmarks/run.py.
+
+Prints (rank 0) one line:
+
+    bench <case> ranks=<n> points=<N> bonds=<B> steps=<S> wall_s=<t>
+          bond_steps_per_s_per_core=<x> bytes_per_bond=<m> ...
+
+bond-steps = bonds x steps (bonds counted per family entry, each pair twice, as
+the peers count them); wall_s is the time loop only (set-up and the first,
+JIT-warming steps excluded), the slowest rank's; per core = divided by ranks.
+"""
+import argparse
+import resource
+import time
+
+from mpi4py import MPI
+
+from mpipd.parallel import Team
+from mpipd.schema import build
+from mpipd.scene import Scene
+from mpipd.solver import Simulation
+
+
+def elastic_block(n: int, steps: int) -> dict:
+    """n^3 granite block, dx = 1 mm, horizon 3 dx, Gaussian-ish velocity pulse."""
+    dx = 1e-3
+    L = n * dx
+    return {
+        "scene": {"name": "bench_elastic"},
+        "time": {"dt": 5e-8, "steps": steps},
+        "materials": {"granite": {"model": "elastic", "density": 2660.0,
+                                  "bulk_modulus": 21.9e9, "shear_modulus": 25.7e9}},
+        "parts": [{"name": "block", "material": "granite", "dx": dx,
+                   "shape": {"kind": "box", "lo": [0, 0, 0], "hi": [L, L, L]}}],
+        "initial": [{"kind": "velocity_pulse", "axis": "z", "center": L / 2,
+                     "half_width": L / 8, "velocity": [0.0, 0.0, 1.0]}],
+    }
+
+
+CASES = {"elastic": elastic_block}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("case", choices=sorted(CASES))
+    ap.add_argument("--size", type=int, default=60, help="points per block edge")
+    ap.add_argument("--steps", type=int, default=20)
+    ap.add_argument("--warmup", type=int, default=2)
+    args = ap.parse_args()
+    team = Team(MPI.COMM_WORLD)
+    scene = build(Scene, CASES[args.case](args.size, args.steps + args.warmup))
+    t0 = time.perf_counter()
+    sim = Simulation(scene, team)
+    setup = team.max(time.perf_counter() - t0)
+    for _ in range(args.warmup):
+        sim.step()
+    team.barrier()
+    t0 = time.perf_counter()
+    for _ in range(args.steps):
+        sim.step()
+    wall = team.max(time.perf_counter() - t0)
+    mem = sim.memory()
+    bpb = team.max(mem["bytes_per_bond"])
+    bpp = team.max(mem["bytes_per_point"])
+    rss = team.max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
+    B = sim.n_bonds_global
+    if team.root:
+        rate = B * args.steps / wall / team.size
+        print(f"bench {args.case} ranks={team.size} points={sim.n_global} bonds={B} "
+              f"steps={args.steps} wall_s={wall:.3f} bond_steps_per_s_per_core={rate:.4g} "
+              f"bytes_per_bond={bpb:.2f} bytes_per_point={bpp:.1f} peak_rss_mib={rss:.0f} "
+              f"setup_s={setup:.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
