@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .schema import Registry, fail, join, positive
+from .schema import Registry, fail, join, ordered_box, positive
 
 SHAPES = Registry("shape", "kind")
 
@@ -51,9 +51,7 @@ class Box:
     hi: tuple[float, float, float]
 
     def check(self, path):
-        for a in range(3):
-            if not self.hi[a] > self.lo[a]:
-                fail(join(path, "hi"), f"must exceed lo in every component (axis {'xyz'[a]})")
+        ordered_box(self, path, strict=True)
 
     def z_levels(self, dx):
         return _cells(self.lo[2], self.hi[2], dx)

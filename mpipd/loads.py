@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .schema import Registry, fail, join, positive
+from .schema import Registry, fail, join, ordered_box, positive
 
 INITIAL = Registry("initial condition", "kind")
 BOUNDARIES = Registry("boundary condition", "kind")
@@ -26,9 +26,7 @@ class Region:
     hi: tuple[float, float, float]
 
     def check(self, path):
-        for a in range(3):
-            if self.hi[a] < self.lo[a]:
-                fail(join(path, "hi"), f"must not be below lo (axis {'xyz'[a]})")
+        ordered_box(self, path, strict=False)
 
     def contains(self, x: np.ndarray) -> np.ndarray:
         lo, hi = np.asarray(self.lo), np.asarray(self.hi)

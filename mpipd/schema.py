@@ -195,3 +195,12 @@ def non_negative(obj, path: str, *names: str) -> None:
         v = getattr(obj, n)
         if not v >= 0:
             fail(join(path, n), f"must be >= 0 (got {v!r})")
+
+
+def ordered_box(obj, path: str, strict: bool) -> None:
+    """``obj.hi`` above (``strict``) or not below ``obj.lo`` on every axis."""
+    for a in range(3):
+        lo, hi = obj.lo[a], obj.hi[a]
+        if (hi <= lo) if strict else (hi < lo):
+            rel = "exceed" if strict else "not be below"
+            fail(join(path, "hi"), f"must {rel} lo on axis {'xyz'[a]} ({hi} vs {lo})")

@@ -54,14 +54,27 @@ def team():
     return Team(MPI.COMM_SELF)
 
 
+_LAUNCHER_VARS = ("PMIX_", "OMPI_MCA_ess", "OMPI_MCA_orte", "OMPI_MCA_pmix", "OMPI_COMM_WORLD",
+                  "OMPI_FIRST", "OMPI_APP", "OMPI_UNIVERSE", "OMPI_NUM_APP", "OMPI_FILE_LOCATION")
+
+
+def child_env():
+    """The environment for child mpiruns.  Once this process has initialised MPI
+    as a singleton (the ``team`` fixture), Open MPI has setenv()'d PMIx and
+    launcher variables into the C environment; a child mpirun that inherits them
+    fails silently.  Python's ``os.environ`` snapshot does not hold them."""
+    return {k: v for k, v in os.environ.items() if not k.startswith(_LAUNCHER_VARS)}
+
+
 def run_cli(args, ranks=None, timeout=300, cwd=None):
     """Run ``mpipd ARGS`` (under ``mpirun -n ranks`` if given); returns CompletedProcess."""
     cmd = [str(BIN / "mpipd"), *args]
     if ranks is not None:
         cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), *cmd]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd,
+                          env=child_env())
 
 
 def run_mpi_script(script, ranks, *args, timeout=300):
     cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(script), *args]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=child_env())

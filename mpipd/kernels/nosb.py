@@ -31,6 +31,16 @@ import numpy as np
 from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
 
 
+@numba.njit(cache=True, inline="always")
+def bond(x, i, j, delta):
+    """Reference bond xi = x_j - x_i and omega = (delta - |xi|)^2 (no volume)."""
+    e0 = x[j, 0] - x[i, 0]
+    e1 = x[j, 1] - x[i, 1]
+    e2 = x[j, 2] - x[i, 2]
+    w = delta - math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    return e0, e1, e2, w * w
+
+
 @numba.njit(cache=True)
 def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcond, points):
     """K^-1 and tr K for the owned points listed in ``points``.
@@ -48,13 +58,8 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcon
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
-            j = nbr[b]
-            e0 = x[j, 0] - x[i, 0]
-            e1 = x[j, 1] - x[i, 1]
-            e2 = x[j, 2] - x[i, 2]
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = di - r
-            w = w * w * vol[j]
+            e0, e1, e2, w = bond(x, i, nbr[b], di)
+            w *= vol[nbr[b]]
             k00 += w * e0 * e0
             k01 += w * e0 * e1
             k02 += w * e0 * e2
@@ -274,12 +279,7 @@ def hourglass_energy(x, u, vol, horizon, offsets, nbr, broken, F, fd, spring):
             if broken[k]:
                 continue
             j = nbr[k]
-            e0 = x[j, 0] - x[i, 0]
-            e1 = x[j, 1] - x[i, 1]
-            e2 = x[j, 2] - x[i, 2]
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = di - r
-            w = w * w
+            e0, e1, e2, w = bond(x, i, j, di)
             z0 = e0 + u[j, 0] - u[i, 0] - (F[i, 0, 0] * e0 + F[i, 0, 1] * e1 + F[i, 0, 2] * e2)
             z1 = e1 + u[j, 1] - u[i, 1] - (F[i, 1, 0] * e0 + F[i, 1, 1] * e1 + F[i, 1, 2] * e2)
             z2 = e2 + u[j, 2] - u[i, 2] - (F[i, 2, 0] * e0 + F[i, 2, 1] * e1 + F[i, 2, 2] * e2)

@@ -22,7 +22,7 @@ import math
 import numba
 import numpy as np
 
-from .linalg import det3, inv3, mul3, mul3_at, mat_to_voigt
+from .linalg import inv3, mat_to_voigt, mul3, mul3_at
 
 
 @numba.njit(cache=True)
