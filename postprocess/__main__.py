@@ -1,0 +1,114 @@
+"""``mpirun -n N python -m postprocess {summary | wave-speed} RUN.h5 [options]``
+
+summary      points, frames, time span, energy drift, peak |v| per frame
+wave-speed   arrival speed of a pulse: the peak time of the cross-section mean of
+             one velocity component at several stations along an axis, fitted by a
+             straight line (parabolic interpolation of each peak between frames)
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from .reader import Run
+
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def summary(run: Run, comm) -> list[str]:
+    from mpi4py import MPI
+    v = run.field("v") if "v" in run.f["fields"] else None
+    e = run.energy("total")
+    t = run.time
+    lines = [f"points {run.n_points}  frames {run.frames}  t {t[0]:.4e}..{t[-1]:.4e} s",
+             f"energy total {e[0]:.6e} -> {e[-1]:.6e} J, max drift "
+             f"{np.abs(e - e[0]).max() / abs(e[0]) if e[0] else float('nan'):.3e} (relative)"]
+    if v is not None:
+        local = np.sqrt((v ** 2).sum(axis=2)).max(axis=1) if v.shape[1] else np.zeros(run.frames)
+        peak = np.empty_like(local)
+        comm.Allreduce(local, peak, op=MPI.MAX)
+        lines.append("peak |v| per frame (m/s): " + " ".join(f"{p:.4g}" for p in peak))
+    return lines
+
+
+def station_means(run: Run, comm, axis: int, comp: int, stations, tol) -> np.ndarray:
+    """(frames, stations) mean of v[..., comp] over points within tol of each station."""
+    from mpi4py import MPI
+    x = run.geometry("x")[:, axis]
+    v = run.field("v")[:, :, comp]
+    sums = np.zeros((run.frames, len(stations)))
+    counts = np.zeros(len(stations))
+    for k, s in enumerate(stations):
+        m = np.abs(x - s) <= tol
+        sums[:, k] = v[:, m].sum(axis=1)
+        counts[k] = m.sum()
+    comm.Allreduce(MPI.IN_PLACE, sums, op=MPI.SUM)
+    comm.Allreduce(MPI.IN_PLACE, counts, op=MPI.SUM)
+    if np.any(counts == 0):
+        raise ValueError(f"no points near station(s) {[s for s, c in zip(stations, counts) if not c]}")
+    return sums / counts
+
+
+def peak_time(t: np.ndarray, y: np.ndarray) -> float:
+    k = int(np.argmax(y))
+    if k == 0 or k == len(y) - 1:
+        raise ValueError("the peak is at the first or last frame: the run is too short "
+                         "or the station too far")
+    y0, y1, y2 = y[k - 1:k + 2]
+    return float(t[k] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2) * (t[k + 1] - t[k]))
+
+
+def wave_speed(run: Run, comm, axis: str, component: str, stations, tol) -> tuple[float, list]:
+    means = station_means(run, comm, AXES[axis], AXES[component], stations, tol)
+    arrivals = [peak_time(run.time, means[:, k]) for k in range(len(stations))]
+    speed = float(np.polyfit(arrivals, stations, 1)[0])
+    return speed, arrivals
+
+
+def main(argv=None) -> int:
+    from mpi4py import MPI
+    comm = MPI.COMM_WORLD
+    ap = argparse.ArgumentParser(prog="python -m postprocess", description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    s = sub.add_parser("summary")
+    s.add_argument("run")
+    w = sub.add_parser("wave-speed")
+    w.add_argument("run")
+    w.add_argument("--axis", default="x", choices=list(AXES))
+    w.add_argument("--component", default="x", choices=list(AXES))
+    w.add_argument("--stations", required=True, help="comma-separated positions along the axis (m)")
+    w.add_argument("--tol", type=float, default=None,
+                   help="half-width of a station (m); default half the lattice spacing")
+    args = ap.parse_args(argv)
+    try:
+        run = Run(args.run, comm)
+    except OSError as e:
+        if comm.Get_rank() == 0:
+            print(f"postprocess: error: cannot open {args.run}: {e}", file=sys.stderr)
+        return 2
+    try:
+        if args.cmd == "summary":
+            lines = summary(run, comm)
+        else:
+            stations = [float(v) for v in args.stations.split(",")]
+            tol = args.tol
+            if tol is None:
+                tol = 0.5 * float(np.cbrt(run.f["geometry"]["volume"][0])) + 1e-12
+            speed, arrivals = wave_speed(run, comm, args.axis, args.component, stations, tol)
+            lines = [f"station {s:.5g} m: peak at {a:.6e} s" for s, a in zip(stations, arrivals)]
+            lines.append(f"wave speed {speed:.2f} m/s")
+    except (KeyError, ValueError) as e:
+        if comm.Get_rank() == 0:
+            print(f"postprocess: error: {e}", file=sys.stderr)
+        return 2
+    finally:
+        run.close()
+    if comm.Get_rank() == 0:
+        print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
