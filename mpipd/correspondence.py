@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from .kernels import integrate, nosb, rotation
+from .kernels.viscosity import viscosity_data
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
 RCOND = 1e-8
@@ -37,12 +38,17 @@ class MaterialGroup:
         self.idx = idx.astype(np.int64)
         self.state = material.new_state(len(idx))
 
-    def update(self, d, dt, sigma):
-        self.material.update(self.idx, d, dt, sigma, self.state)
+    def update(self, d, J, dt, sigma, mode):
+        self.material.update(self.idx, d, J, dt, sigma, mode, self.state)
+
+    def check_tension(self, sigma, d, mode) -> int:
+        t = getattr(self.material, "tension", None)
+        return t.apply(self.idx, sigma, d, mode) if t is not None else 0
 
 
 class Correspondence:
-    def __init__(self, points, families, materials: dict, material_names, hourglass: float):
+    def __init__(self, points, families, materials: dict, material_names, hourglass: float,
+                 contact: bool = False, viscosity=None):
         n, nl = points.n_owned, points.n_local
         self.points = points
         self.families = families
@@ -65,7 +71,17 @@ class Correspondence:
         self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
         self.J = np.ones(n)
         self.W = np.zeros(n)                    # strain energy per reference volume
-        self.fd = np.zeros((nl, 11))            # force data, owned + ghosts
+        self.gamma = np.zeros(n)                # sum_j omega V_j (Eq. 43)
+        self.contact = bool(contact)
+        self.viscosity = viscosity
+        # force data of owned + ghost points: B (9), h, fallback flag [, viscosity (2)]
+        self.fd = np.zeros((nl, 13 if viscosity is not None else 11))
+        self.dil = np.zeros(n if viscosity is not None else 0)
+        if viscosity is not None:
+            rho = np.array([m.density for m in mats])[points.material[:n]]
+            K = np.array([m.bulk_modulus for m in mats])[points.material[:n]]
+            self.visc_l = viscosity.cl * rho * np.sqrt(K / rho)        # C_l rho0 c0
+            self.visc_q = viscosity.cq * rho                           # C_q rho0
         self.hg_modulus = np.array([hourglass * m.hourglass_modulus for m in mats])[
             points.material[:n]]
         # bond-spring constant 18 k / (pi delta^4) of every local point
@@ -81,36 +97,45 @@ class Correspondence:
         if which is None:
             which = np.arange(p.n_owned, dtype=np.int64)
         nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.Kinv, self.trK, self.spring, RCOND, which)
+                           self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
         self.n_spring = int(np.count_nonzero(self.spring))
         return self.n_spring
 
     def deform(self, u, v):
         p, fam = self.points, self.families
         nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot)
+                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
+                                   self.dil)
 
     def rotate(self, dt: float):
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
                                 self.spring, self.d, self.J)
 
-    def update_stress(self, dt: float):
+    def update_stress(self, dt: float, mode: np.ndarray):
+        """Materials advance the stress; ``mode`` (failure flags) may be set by them."""
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
         for g in self.groups:
-            g.update(self.d, dt, self.sigma)
+            g.update(self.d, self.J, dt, self.sigma, mode)
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
+
+    def check_tension(self, mode: np.ndarray) -> int:
+        """Tension failure model (Eqs. 37–38) of the materials that have one."""
+        return sum(g.check_tension(self.sigma, self.d, mode) for g in self.groups)
 
     def force_data(self) -> int:
         n_bad = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK, self.spring,
                                 self.hg_modulus, self.fd)
+        if self.viscosity is not None:
+            viscosity_data(self.dil, self.gamma, self.J, self.trK, self.spring,
+                           self.visc_l, self.visc_q, self.fd)
         if n_bad:
             self.n_spring = int(np.count_nonzero(self.spring))
         return n_bad
 
-    def gather(self, u, f):
+    def gather(self, u, v, f):
         p, fam = self.points, self.families
-        nosb.gather_forces(p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.fd, self.cbb, f)
+        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
+                           self.fd, self.cbb, self.contact, f)
 
     def commit(self):
         self.F_old[...] = self.F

@@ -43,17 +43,34 @@ def n_frames(n_steps: int, every: int) -> int:
     return n_steps // every + 1 + (1 if n_steps % every else 0)
 
 
+def _state(key):
+    """A material state array (e.g. JH2's D) as a field over all owned points (0 elsewhere)."""
+    def get(sim):
+        out = np.zeros(sim.points.n_owned)
+        for g in sim.corr.groups:
+            if key in g.state:
+                out[g.idx] = g.state[key]
+        return out
+    return get
+
+
+#: how each output field is read from a Simulation (owned points, gid order)
+FIELD_VALUES = {
+    "u": lambda sim: sim.u[:sim.points.n_owned],
+    "v": lambda sim: sim.v[:sim.points.n_owned],
+    "stress": lambda sim: sim.corr.cauchy_stress(),
+    "strain_energy": lambda sim: sim.corr.W,
+    "damage": lambda sim: sim.failure.phi,
+    "failure_mode": lambda sim: sim.failure.mode[:sim.points.n_owned].astype(np.float64),
+    "jh2_damage": _state("D"),
+    "pressure": _state("pressure"),
+    "plastic_strain": _state("eps_p"),
+    "strain_rate": _state("strain_rate"),
+}
+
+
 def field_values(sim, name: str) -> np.ndarray:
-    n = sim.points.n_owned
-    if name == "u":
-        return sim.u[:n]
-    if name == "v":
-        return sim.v[:n]
-    if name == "stress":
-        return sim.corr.cauchy_stress()
-    if name == "strain_energy":
-        return sim.corr.W
-    raise KeyError(name)
+    return FIELD_VALUES[name](sim)
 
 
 class Writer:
@@ -97,7 +114,7 @@ class Writer:
         fg = self.f.create_group("fields")
         self.dsets = {}
         for name in self.fields:
-            k = OUTPUT_FIELDS[name]
+            k = OUTPUT_FIELDS[name][0]
             shape = (self.n_frames, N) if k == 1 else (self.n_frames, N, k)
             self.dsets[name] = fg.create_dataset(name, shape, "f8")
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8")
@@ -155,7 +172,7 @@ def write_xdmf(h5path: Path, N: int, fields, frames: int, times) -> Path:
                   f'<DataItem Dimensions="{N} 3" NumberType="Float" Precision="8" '
                   f'Format="HDF">{h5}:/geometry/x</DataItem>', "</Geometry>"]
         for name in fields:
-            kk = OUTPUT_FIELDS[name]
+            kk = OUTPUT_FIELDS[name][0]
             kind = {1: "Scalar", 3: "Vector", 6: "Matrix"}[kk]   # stress: Voigt xx yy zz yz xz xy
             dims = f"{N}" if kk == 1 else f"{N} {kk}"
             full = f"{frames} {N}" if kk == 1 else f"{frames} {N} {kk}"

@@ -22,8 +22,8 @@ from .geometry import LayerTable
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it)
 BYTES_PER_LOCAL_POINT = 208     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb
-BYTES_PER_OWNED_POINT = 634     # a, f, rho, fixed, offsets, K^-1, tr K, spring, F, F_old,
-#                                 Fdot, R, V, sigma, d, J, W, hourglass modulus, group index
+BYTES_PER_OWNED_POINT = 642     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
+#                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group index
 BYTES_PER_BOND = 5              # nbr (int32) + broken (uint8)
 
 

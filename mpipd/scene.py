@@ -37,8 +37,14 @@ from .schema import SceneError, build, fail, join, non_negative, positive, tagge
 
 HORIZON_TOL = 1e-3
 
-#: per-point fields that ``[output] fields`` may name, with their components
-OUTPUT_FIELDS = {"u": 3, "v": 3, "stress": 6, "strain_energy": 1}
+#: per-point fields that ``[output] fields`` may name: components and what the scene needs
+OUTPUT_FIELDS = {
+    "u": (3, None), "v": (3, None), "stress": (6, None), "strain_energy": (1, None),
+    "damage": (1, "failure"),            # PD damage phi (Eq. 39)
+    "failure_mode": (1, "failure"),      # 0 intact, 1 JH2 D >= 1, 2 JH2 p* < -T*, 3 tension model
+    "jh2_damage": (1, "jh2"), "pressure": (1, "jh2"), "plastic_strain": (1, "jh2"),
+    "strain_rate": (1, "jh2"),
+}
 
 
 @dataclass(frozen=True)
@@ -89,12 +95,28 @@ class Part:
 
 
 @dataclass(frozen=True)
-class Solver:
-    hourglass: float = 0.01
-    progress_every: int = 0           # steps between progress lines; 0 = about every 2 s
+class Viscosity:
+    """Artificial viscosity (Eqs. 42–44): quadratic ``cq`` and linear ``cl`` coefficients."""
+    cq: float = 8.0
+    cl: float = 0.1
 
     def check(self, path):
-        non_negative(self, path, "hourglass", "progress_every")
+        non_negative(self, path, "cq", "cl")
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Numerical switches.  ``damping`` is c of Eq. 41 in 1/s for points with
+    phi = 1 (the paper's 0.2 per microsecond is 2e5 1/s); 0 switches it off.
+    ``contact`` turns on Eq. 40 on broken bonds; ``viscosity`` Eqs. 42–44."""
+    hourglass: float = 0.01
+    progress_every: int = 0           # steps between progress lines; 0 = about every 2 s
+    contact: bool = False
+    damping: float = 0.0
+    viscosity: Viscosity | None = None
+
+    def check(self, path):
+        non_negative(self, path, "hourglass", "progress_every", "damping")
 
 
 @dataclass(frozen=True)
@@ -108,6 +130,8 @@ class Output:
             if f not in OUTPUT_FIELDS:
                 fail(join(join(path, "fields"), i),
                      f"unknown field {f!r} (known: {', '.join(OUTPUT_FIELDS)})")
+        if len(set(self.fields)) != len(self.fields):
+            fail(join(path, "fields"), "a field is listed twice")
 
 
 @dataclass(frozen=True)
@@ -134,6 +158,13 @@ class Scene:
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
             names.add(p.name)
+        needs = {"failure": self.can_fail, "jh2": self.has_model("jh2")}
+        for i, f in enumerate(self.output.fields):
+            need = OUTPUT_FIELDS[f][1]
+            if need is not None and not needs[need]:
+                what = ("a material that can fail (jh2, or a tension model)" if need == "failure"
+                        else "a jh2 material")
+                fail(f"output.fields[{i}]", f"{f!r} needs {what}")
 
     @property
     def name(self) -> str:
@@ -143,6 +174,15 @@ class Scene:
     def material_ids(self) -> dict[str, int]:
         """Material name -> id, in the order the scene defines them."""
         return {m: k for k, m in enumerate(self.materials)}
+
+    @property
+    def can_fail(self) -> bool:
+        used = {p.material for p in self.parts}
+        return any(self.materials[m].can_fail for m in used)
+
+    def has_model(self, name: str) -> bool:
+        used = {p.material for p in self.parts}
+        return any(self.materials[m].registry_name == name for m in used)
 
     @property
     def max_horizon(self) -> float:

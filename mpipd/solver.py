@@ -28,6 +28,7 @@ import numpy as np
 
 from .correspondence import Correspondence
 from .decomp import decompose, halo_width, local_points
+from .failure import Failure
 from .families import build_families
 from .geometry import LayerTable
 from .halo import Halo
@@ -74,9 +75,15 @@ class Simulation:
             ic.apply(p.x[:n], self.v[:n])
         self.v[:n][self.fixed.astype(bool)] = 0.0
 
-        self.corr = Correspondence(p, self.families, scene.materials, names,
-                                   scene.solver.hourglass)
+        sv = scene.solver
+        self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
+                                   contact=sv.contact, viscosity=sv.viscosity)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
+        # failure and bond breakage exist only if some material can fail
+        self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping)
+                        if scene.can_fail else None)
+        self.mode = self.failure.mode if self.failure else np.zeros(p.n_local, np.uint8)
+        self.damp = self.failure.damp if self.failure else np.zeros(0)
         self.step_count = 0
         self.t = 0.0
         self.initialize()
@@ -94,22 +101,25 @@ class Simulation:
         """Force data of owned points -> halo -> gathered internal force density."""
         self.corr.force_data()
         self.halo.exchange(self.corr.fd)
-        self.corr.gather(self.u, self.f)
+        self.corr.gather(self.u, self.v, self.f)
 
     def update(self, dt: float):
         """Everything between the two half kicks: kinematics, stress, forces."""
         self.halo.exchange(self.u, self.v)
         self.corr.deform(self.u, self.v)
         self.corr.rotate(dt)
-        self.corr.update_stress(dt)
+        self.corr.update_stress(dt, self.mode)
         self.compute_forces()
         self.corr.commit()
 
     def step(self):
         dt = self.dt
-        integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed)
+        integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed, self.damp)
         self.update(dt)
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
+        if self.failure is not None:                # paper §2.7 steps 11–12
+            self.corr.check_tension(self.mode)
+            self.failure.update()
         self.step_count += 1
         self.t = self.step_count * dt
 
@@ -133,6 +143,10 @@ class Simulation:
         c = self.corr
         arrays += [c.Kinv, c.trK, c.spring, c.F, c.F_old, c.Fdot, c.R, c.V, c.sigma, c.d,
                    c.J, c.W, c.fd, c.hg_modulus, c.cbb]
+        arrays += [c.gamma, c.dil]
+        if self.failure is not None:
+            fl = self.failure
+            arrays += [fl.mode, fl.done, fl.phi, fl.touched, fl.damp]
         for g in c.groups:
             arrays += list(g.state.values()) + [g.idx]
         point = sum(a.nbytes for a in arrays)

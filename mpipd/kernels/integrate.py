@@ -10,13 +10,26 @@ import numba
 
 
 @numba.njit(cache=True)
-def kick_drift(u, v, a, dt, fixed):
-    """Half kick then drift, owned points (rows of ``a``)."""
+def kick_drift(u, v, a, dt, fixed, damp):
+    """Half kick then drift, owned points (rows of ``a``).
+
+    Points with damp[i] = c > 0 (``damp`` may be empty) follow the damped update of
+    Eq. 41, v_{n+1/2} = [(2 - c dt) v_{n-1/2} + 2 dt a_n] / (2 + c dt), written
+    with v_n = v_{n-1/2} + dt/2 a_n as
+    v_{n+1/2} = [(2 - c dt) v_n + (1 + c dt / 2) dt a_n] / (2 + c dt).
+    """
     h = 0.5 * dt
+    damped = damp.shape[0] > 0
     for i in range(a.shape[0]):
         if fixed[i]:
             for c in range(3):
                 v[i, c] = 0.0
+            continue
+        if damped and damp[i] > 0.0:
+            cd = damp[i] * dt
+            for c in range(3):
+                v[i, c] = ((2.0 - cd) * v[i, c] + (1.0 + 0.5 * cd) * dt * a[i, c]) / (2.0 + cd)
+                u[i, c] += dt * v[i, c]
             continue
         for c in range(3):
             v[i, c] += h * a[i, c]

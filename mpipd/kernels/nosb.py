@@ -28,7 +28,9 @@ import math
 import numba
 import numpy as np
 
+from .contact import contact_force
 from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
+from .viscosity import viscous_bond
 
 
 @numba.njit(cache=True, inline="always")
@@ -42,8 +44,9 @@ def bond(x, i, j, delta):
 
 
 @numba.njit(cache=True)
-def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcond, points):
-    """K^-1 and tr K for the owned points listed in ``points``.
+def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, gamma, spring, rcond,
+                  points):
+    """K^-1, tr K and gamma = sum_j omega V_j (Eq. 43) for the owned points in ``points``.
 
     A point with fewer than 3 intact bonds, or with det K <= rcond (tr K / 3)^3,
     is marked ``spring[i] = 1`` (bond-spring fallback).  Returns how many are.
@@ -53,6 +56,7 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcon
     for p in range(points.shape[0]):
         i = points[p]
         k00 = k01 = k02 = k11 = k12 = k22 = 0.0
+        g = 0.0
         nb = 0
         di = horizon[i]
         for b in range(offsets[i], offsets[i + 1]):
@@ -60,6 +64,7 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcon
                 continue
             e0, e1, e2, w = bond(x, i, nbr[b], di)
             w *= vol[nbr[b]]
+            g += w
             k00 += w * e0 * e0
             k01 += w * e0 * e1
             k02 += w * e0 * e2
@@ -75,6 +80,7 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcon
         K[1, 2] = K[2, 1] = k12
         tr = k00 + k11 + k22
         trK[i] = tr
+        gamma[i] = g
         d = det3(K)
         if nb < 3 or not d > rcond * (tr / 3.0) ** 3:
             spring[i] = 1
@@ -89,8 +95,11 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, spring, rcon
 
 
 @numba.njit(cache=True)
-def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spring, F, Fdot):
-    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v."""
+def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spring, F, Fdot,
+                          dil):
+    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v.  If ``dil``
+    has rows, also dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
+    want_dil = dil.shape[0] > 0
     n = offsets.shape[0] - 1
     N = np.empty((3, 3))
     Nd = np.empty((3, 3))
@@ -102,6 +111,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
                     Fdot[i, r, c] = 0.0
             continue
         n00 = n01 = n02 = n10 = n11 = n12 = n20 = n21 = n22 = 0.0
+        acc = 0.0
         m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
@@ -144,6 +154,10 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
             m20 += z2 * e0
             m21 += z2 * e1
             m22 += z2 * e2
+            if want_dil:
+                acc += (z0 * e0 + z1 * e1 + z2 * e2) / r
+        if want_dil:
+            dil[i] = acc
         N[0, 0], N[0, 1], N[0, 2] = n00, n01, n02
         N[1, 0], N[1, 1], N[1, 2] = n10, n11, n12
         N[2, 0], N[2, 1], N[2, 2] = n20, n21, n22
@@ -200,9 +214,15 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
 
 
 @numba.njit(cache=True)
-def gather_forces(x, u, vol, horizon, offsets, nbr, broken, fd, cbb, f):
-    """Internal force density f (N/m^3) of every owned point (see module docstring)."""
+def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact, f):
+    """Internal force density f (N/m^3) of every owned point (see module docstring).
+
+    ``contact``: broken bonds in compression push apart (Eq. 40, see
+    kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
+    (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, 11:13] and v.
+    """
     n = offsets.shape[0] - 1
+    visc = fd.shape[1] > 11
     for i in range(n):
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
@@ -214,8 +234,6 @@ def gather_forces(x, u, vol, horizon, offsets, nbr, broken, fd, cbb, f):
         si = fd[i, 10]
         fx = fy = fz = 0.0
         for k in range(offsets[i], offsets[i + 1]):
-            if broken[k]:
-                continue
             j = nbr[k]
             e0 = x[j, 0] - xi0
             e1 = x[j, 1] - xi1
@@ -224,29 +242,46 @@ def gather_forces(x, u, vol, horizon, offsets, nbr, broken, fd, cbb, f):
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            if broken[k]:
+                if contact:
+                    g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
+                                      0.5 * (di + horizon[j]))
+                    vj = vol[j]
+                    fx += g * y0 * vj
+                    fy += g * y1 * vj
+                    fz += g * y2 * vj
+                continue
             tx = ty = tz = 0.0
+            wi = di - r
+            wi = wi * wi
             if si == 0.0:
-                w = di - r
-                w = w * w
-                tx = w * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
-                ty = w * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
-                tz = w * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
+                tx = wi * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
+                ty = wi * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
+                tz = wi * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
             else:
                 g = _spring(cbb[i], r, y0, y1, y2)
                 tx, ty, tz = g * y0, g * y1, g * y2
             dj = horizon[j]
+            wj = 0.0
             if r < dj:
+                wj = dj - r
+                wj = wj * wj
                 if fd[j, 10] == 0.0:
-                    w = dj - r
-                    w = w * w
-                    tx += w * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)
-                    ty += w * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, 9] * y1)
-                    tz += w * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, 9] * y2)
+                    tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)
+                    ty += wj * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, 9] * y1)
+                    tz += wj * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, 9] * y2)
                 else:
                     g = _spring(cbb[j], r, y0, y1, y2)
                     tx += g * y0
                     ty += g * y1
                     tz += g * y2
+            if visc:
+                c = viscous_bond(wi, wj, fd[i, 11], fd[i, 12], fd[j, 11], fd[j, 12],
+                                 v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
+                                 e0, e1, e2, r)
+                tx -= c * e0
+                ty -= c * e1
+                tz -= c * e2
             vj = vol[j]
             fx += tx * vj
             fy += ty * vj

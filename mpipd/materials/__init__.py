@@ -14,9 +14,15 @@ Interface (see :class:`mpipd.materials.base.Material`):
 ``new_state(n)``
     the material's history arrays for its ``n`` owned points (a dict; empty for
     elastic) — they exist only for points of this material;
-``update(idx, d, dt, sigma, state)``
+``update(idx, d, J, dt, sigma, mode, state)``
     advance the unrotated stress ``sigma[idx]`` (Voigt order xx, yy, zz, yz,
-    xz, xy) by one step from ``d[idx]``;
+    xz, xy) by one step from ``d[idx]`` and J = det F; points with
+    ``mode[i] != 0`` have failed and are skipped; a model that detects failure
+    sets ``mode[i]`` (1 JH2 plastic, 2 JH2 tensile) and zeroes the stress;
+``tension``
+    optional rate-dependent tension failure model (Eqs. 37–38, mode 3);
+``can_fail``
+    whether points of this material can fail (then bonds break);
 ``exchanged``
     names of per-point fields the material needs in the halo besides the
     correspondence data (none for elastic).
@@ -25,4 +31,4 @@ from ..schema import Registry
 
 MATERIALS = Registry("material model", "model")
 
-from . import elastic  # noqa: E402,F401  (registers)
+from . import elastic, jh2  # noqa: E402,F401  (registers)

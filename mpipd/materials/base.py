@@ -34,5 +34,9 @@ class Material:
         """Modulus that gives the hourglass penalty (Eq. 15) its units: G."""
         return self.shear_modulus
 
+    @property
+    def can_fail(self) -> bool:
+        return getattr(self, "tension", None) is not None
+
     def new_state(self, n: int) -> dict:
         return {}

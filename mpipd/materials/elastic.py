@@ -18,13 +18,17 @@ import numpy as np
 
 from . import MATERIALS
 from .base import Material
+from .tension import TensionFailure
 
 
 @numba.njit(cache=True)
-def hypoelastic_update(idx, d, dt, sigma, lam, mu):
-    """sigma[i] += dt (lam tr(d) I + 2 mu d) for i in idx (Voigt xx yy zz yz xz xy)."""
+def hypoelastic_update(idx, d, dt, sigma, mode, lam, mu):
+    """sigma[i] += dt (lam tr(d) I + 2 mu d) for i in idx (Voigt xx yy zz yz xz xy),
+    failed points (mode[i] != 0) excepted."""
     for k in range(idx.shape[0]):
         i = idx[k]
+        if mode[i] != 0:
+            continue
         tr = d[i, 0] + d[i, 1] + d[i, 2]
         for c in range(3):
             sigma[i, c] += dt * (lam * tr + 2.0 * mu * d[i, c])
@@ -35,11 +39,13 @@ def hypoelastic_update(idx, d, dt, sigma, lam, mu):
 @MATERIALS.register("elastic")
 @dataclass(frozen=True)
 class Elastic(Material):
-    """Isotropic elastic solid: ``density`` (kg/m³), ``bulk_modulus``, ``shear_modulus`` (Pa)."""
+    """Isotropic elastic solid: ``density`` (kg/m³), ``bulk_modulus``, ``shear_modulus`` (Pa),
+    optionally with the tension failure model (``tension``)."""
     density: float
     bulk_modulus: float
     shear_modulus: float
+    tension: TensionFailure | None = None
 
-    def update(self, idx: np.ndarray, d: np.ndarray, dt: float, sigma: np.ndarray,
-               state: dict) -> None:
-        hypoelastic_update(idx, d, dt, sigma, self.lame_lambda, self.shear_modulus)
+    def update(self, idx: np.ndarray, d: np.ndarray, J: np.ndarray, dt: float,
+               sigma: np.ndarray, mode: np.ndarray, state: dict) -> None:
+        hypoelastic_update(idx, d, dt, sigma, mode, self.lame_lambda, self.shear_modulus)

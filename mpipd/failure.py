@@ -1,0 +1,77 @@
+"""Point failure -> bond breakage, PD damage phi and the damped set (paper §2.4).
+
+Built only when some material of the scene can fail (JH2, or a tension model).
+Every step, after the materials and the tension model have marked failed
+owned points in ``mode`` (1 JH2 plastic, 2 JH2 tensile, 3 tension model):
+
+1. the halo copies ``mode`` to the ghosts (one uint8 per point);
+2. points that failed since the last step — owned or ghost — are looked up in a
+   cKDTree of reference positions (built once) for owned candidates within
+   (largest horizon + dx_k / 2); only those candidates' bonds are tested
+   (mpipd.kernels.breakage), never all bonds;
+3. owned points that lost bonds get a new shape tensor (bond-spring fallback
+   where too few bonds are left) and a new damage phi (Eq. 39);
+4. owned points with phi = 1 join the damped set (Eq. 41).
+
+Each rank breaks only its owned points' bonds, by the same rule from the same
+(ghost-copied) flags, so both directions of a bond break on the same step.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .kernels.breakage import break_bonds, pairs_from_lists, pd_damage
+
+MODE_NAMES = {0: "intact", 1: "JH2 plastic (D >= 1)", 2: "JH2 tensile (p* < -T*)",
+              3: "tension model (Eqs. 37-38)"}
+
+
+class Failure:
+    def __init__(self, points, families, halo, corr, damping: float):
+        self.points = points
+        self.families = families
+        self.halo = halo
+        self.corr = corr
+        n, nl = points.n_owned, points.n_local
+        self.mode = np.zeros(nl, dtype=np.uint8)
+        self.done = np.zeros(nl, dtype=np.uint8)
+        self.phi = np.zeros(n)
+        self.touched = np.zeros(n, dtype=np.uint8)
+        self.damping = damping
+        self.damp = np.zeros(n) if damping > 0 else np.zeros(0)
+        self.tree = cKDTree(points.x)
+        self.reach = float(points.horizon.max()) if nl else 0.0
+        self.bonds_broken = 0
+        self.seconds = 0.0                      # wall time spent here (bookkeeping share)
+        pd_damage(np.arange(n, dtype=np.int64), families.offsets, families.nbr,
+                  families.broken, points.volume, self.phi)
+
+    def update(self) -> int:
+        """Exchange failure flags and break bonds.  Returns the newly failed local points."""
+        t0 = time.perf_counter()
+        self.halo.exchange(self.mode)
+        new = np.flatnonzero((self.mode != 0) & (self.done == 0))
+        if len(new):
+            self.done[new] = 1
+            p, fam = self.points, self.families
+            lists = self.tree.query_ball_point(p.x[new], self.reach + 0.5 * p.dx[new])
+            rows, items = pairs_from_lists(lists)
+            own = items < p.n_owned
+            self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx,
+                                             fam.offsets, fam.nbr, fam.broken, self.touched)
+            changed = np.flatnonzero(self.touched)
+            if len(changed):
+                self.touched[changed] = 0
+                self.corr.rebuild_shape(changed)
+                pd_damage(changed, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
+                if self.damping > 0:
+                    self.damp[changed] = np.where(self.phi[changed] >= 1.0, self.damping, 0.0)
+        self.seconds += time.perf_counter() - t0
+        return len(new)
+
+    def counts(self) -> np.ndarray:
+        """Owned failed points per mode (index = mode)."""
+        return np.bincount(self.mode[: self.points.n_owned], minlength=4)

@@ -1,0 +1,203 @@
+"""Johnson–Holmquist (JH2) ceramic/rock model (Johnson & Holmquist 1994; paper §2.2, Eqs. 19–36).
+
+Sign convention.  mpipd stresses are tension-positive; JH2's pressure p is
+compression-positive, so the Cauchy stress is sigma = S - p I with S the
+deviator (the paper writes Eq. 35 as sigma = S + p I in a compression-positive
+frame).
+
+Per point and step, in the unrotated frame (d from Eq. 6, dt):
+
+1. Compression mu = rho/rho0 - 1 = 1/J - 1 (J = det F).  Pressure (Eq. 25)
+       p = K1 mu + K2 mu^2 + K3 mu^3 + dp   (mu >= 0),   p = K1 mu + dp   (mu < 0).
+   The pressure comes from the EOS on the total compression, as in JH2; the
+   paper's Eq. 19 would integrate it incrementally, which contradicts Eq. 25.
+2. Tensile failure: p* = p / p_HEL < -T* (i.e. p < -T)  ->  the point fails (mode 2).
+3. Trial deviator S' = S + 2 G dev(d) dt (Eq. 19), von Mises s = sqrt(3/2 S':S') (Eq. 20).
+4. Strain rate (Eq. 24) edot = sqrt(2/3 dev(d):dev(d)), edot* = max(edot / edot_n, 1)
+   (clamped so ln edot* >= 0).  Strengths (Eqs. 21–23):
+       sigma_i* = A (p* + T*)^N (1 + C ln edot*),
+       sigma_f* = B (p*)^M (1 + C ln edot*)  (0 for p* <= 0),
+       sigma_y  = sigma_HEL [sigma_i* - D (sigma_i* - sigma_f*)],  sigma_HEL = 1.5 (HEL - p_HEL).
+5. If s > sigma_y: radial return S = (sigma_y / s) S' (Eq. 31).  The plastic deviatoric
+   strain increment (S' - S)/(2G) is parallel to S, so Eqs. 32–34 give
+   deps_p = (s - sigma_y) / (3 G).  Damage (Eqs. 29–30):
+       D += deps_p / eps_f,  eps_f = D1 (p* + T*)^D2;  D >= 1  ->  the point fails (mode 1).
+6. Bulking (Eqs. 26–28): the strength lost to the damage step, at this p* and
+   edot*, releases dU = [sigma_y(D_old)^2 - sigma_y(D_new)^2] / (6 G) > 0 and
+       dp <- -K1 mu + sqrt((K1 mu + dp)^2 + 2 beta K1 dU).
+7. sigma = S - (p_EOS + dp) I (Eq. 35); the correspondence module rotates it (Eq. 36).
+
+A failed point carries no stress; its bonds break (mpipd.failure).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from ..schema import fail, join, non_negative, positive
+from . import MATERIALS
+from .base import Material
+from .tension import TensionFailure
+
+MODE_PLASTIC = 1     # D reached 1
+MODE_TENSILE = 2     # p* < -T*
+
+
+@numba.njit(cache=True, inline="always")
+def jh2_pressure(mu, K1, K2, K3):
+    """Eq. 25 without the bulking term."""
+    if mu >= 0.0:
+        return K1 * mu + K2 * mu * mu + K3 * mu * mu * mu
+    return K1 * mu
+
+
+@numba.njit(cache=True, inline="always")
+def jh2_strength(ps, rate, D, A, N, B, M, T_star):
+    """Normalised yield strength sigma_y* (Eqs. 21–23); ps = p*, rate = 1 + C ln edot*."""
+    si = A * (ps + T_star) ** N * rate if ps + T_star > 0.0 else 0.0
+    sf = B * ps ** M * rate if ps > 0.0 else 0.0
+    return si - D * (si - sf)
+
+
+@numba.njit(cache=True)
+def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
+               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T, beta, D1, D2, rate_norm):
+    """Advance the unrotated stress of the JH2 points ``idx`` (state arrays are
+    compact: entry k belongs to point idx[k]).  Sets mode[i] on failure."""
+    T_star = T / p_hel
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        if mode[i] != 0:
+            continue
+        mu = 1.0 / J[i] - 1.0
+        p_eos = jh2_pressure(mu, K1, K2, K3)
+        p = p_eos + dp[k]
+        pressure[k] = p
+        if p < -T:
+            mode[i] = MODE_TENSILE
+            for c in range(6):
+                sigma[i, c] = 0.0
+            continue
+        # deviatoric rate and trial deviator
+        tr = (d[i, 0] + d[i, 1] + d[i, 2]) / 3.0
+        e0, e1, e2 = d[i, 0] - tr, d[i, 1] - tr, d[i, 2] - tr
+        e3, e4, e5 = d[i, 3], d[i, 4], d[i, 5]
+        sm = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
+        s0 = sigma[i, 0] - sm + 2.0 * G * e0 * dt
+        s1 = sigma[i, 1] - sm + 2.0 * G * e1 * dt
+        s2 = sigma[i, 2] - sm + 2.0 * G * e2 * dt
+        s3 = sigma[i, 3] + 2.0 * G * e3 * dt
+        s4 = sigma[i, 4] + 2.0 * G * e4 * dt
+        s5 = sigma[i, 5] + 2.0 * G * e5 * dt
+        seq = math.sqrt(1.5 * (s0 * s0 + s1 * s1 + s2 * s2
+                               + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)))
+        edot = math.sqrt(2.0 / 3.0 * (e0 * e0 + e1 * e1 + e2 * e2
+                                      + 2.0 * (e3 * e3 + e4 * e4 + e5 * e5)))
+        rate_out[k] = edot
+        es = edot / rate_norm
+        rate = 1.0 + C * math.log(es) if es > 1.0 else 1.0
+        ps = p / p_hel
+        sy = sigma_hel * jh2_strength(ps, rate, D[k], A, N, B, M, T_star)
+        if seq > sy:
+            f = sy / seq if seq > 0.0 else 0.0
+            s0 *= f
+            s1 *= f
+            s2 *= f
+            s3 *= f
+            s4 *= f
+            s5 *= f
+            deps = (seq - sy) / (3.0 * G)
+            eps_p[k] += deps
+            eps_f = D1 * (ps + T_star) ** D2
+            D_old = D[k]
+            D_new = D_old + deps / eps_f if eps_f > 0.0 else 1.0
+            if D_new >= 1.0:
+                D[k] = 1.0
+                mode[i] = MODE_PLASTIC
+                for c in range(6):
+                    sigma[i, c] = 0.0
+                continue
+            D[k] = D_new
+            sy_new = sigma_hel * jh2_strength(ps, rate, D_new, A, N, B, M, T_star)
+            dU = (sy * sy - sy_new * sy_new) / (6.0 * G)
+            if dU > 0.0:
+                x = K1 * mu + dp[k]
+                dp[k] = -K1 * mu + math.sqrt(x * x + 2.0 * beta * K1 * dU)
+                p = p_eos + dp[k]
+                pressure[k] = p
+        sigma[i, 0] = s0 - p
+        sigma[i, 1] = s1 - p
+        sigma[i, 2] = s2 - p
+        sigma[i, 3] = s3
+        sigma[i, 4] = s4
+        sigma[i, 5] = s5
+
+
+@MATERIALS.register("jh2")
+@dataclass(frozen=True)
+class JH2(Material):
+    """JH2 with the granite of the paper's Table 1 as defaults (SI units).
+
+    ``bulk_modulus`` is K1.  ``tension`` optionally adds the rate-dependent
+    tension failure model (Eqs. 37–38).
+    """
+    density: float = 2660.0
+    bulk_modulus: float = 21.9e9          # K1
+    shear_modulus: float = 25.7e9
+    K2: float = -4500e9
+    K3: float = 300000e9
+    HEL: float = 4.5e9
+    p_HEL: float = 3.7e9
+    A: float = 1.9
+    N: float = 0.62
+    B: float = 0.25
+    M: float = 0.62
+    C: float = 0.005
+    T: float = 54e6
+    beta: float = 0.5
+    D1: float = 0.005
+    D2: float = 0.7
+    rate_norm: float = 1.0                # edot_n of Eq. 22 (1/s)
+    tension: TensionFailure | None = None
+
+    def check(self, path):
+        super().check(path)
+        positive(self, path, "HEL", "p_HEL", "A", "N", "B", "M", "T", "D1", "D2", "rate_norm")
+        non_negative(self, path, "C", "beta")
+        if not self.HEL > self.p_HEL:
+            fail(join(path, "HEL"), f"must exceed p_HEL ({self.HEL} <= {self.p_HEL})")
+
+    @property
+    def sigma_hel(self) -> float:
+        return 1.5 * (self.HEL - self.p_HEL)
+
+    @property
+    def can_fail(self) -> bool:
+        return True
+
+    def new_state(self, n: int) -> dict:
+        return {"D": np.zeros(n), "eps_p": np.zeros(n), "dp": np.zeros(n),
+                "pressure": np.zeros(n), "strain_rate": np.zeros(n)}
+
+    def update(self, idx, d, J, dt, sigma, mode, state):
+        s = state
+        jh2_update(idx, d, J, dt, sigma, mode, s["D"], s["eps_p"], s["dp"], s["pressure"],
+                   s["strain_rate"], self.shear_modulus, self.bulk_modulus, self.K2, self.K3,
+                   self.sigma_hel, self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T,
+                   self.beta, self.D1, self.D2, self.rate_norm)
+
+    def negative_tangent(self) -> tuple[float, float] | None:
+        """The compression range (mu_lo, mu_hi) where dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 < 0."""
+        a, b, c = 3.0 * self.K3, 2.0 * self.K2, self.bulk_modulus
+        if a == 0.0:
+            return None if b >= 0 else (-c / b, math.inf)
+        disc = b * b - 4 * a * c
+        if disc <= 0:
+            return None
+        r = sorted(((-b - math.sqrt(disc)) / (2 * a), (-b + math.sqrt(disc)) / (2 * a)))
+        if r[1] <= 0:
+            return None
+        return (max(r[0], 0.0), r[1])
