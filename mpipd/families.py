@@ -1,7 +1,11 @@
 """Peridynamic families in CSR form, built with scipy's cKDTree.
 
 For every owned point i, the family is every local point j != i (owned or
-ghost) with |x_j - x_i| < delta_i, stored as
+ghost) with |x_j - x_i| < max(delta_i, delta_j) — the union of i's horizon and
+the points whose horizon reaches i, so that where horizons differ (dual
+horizons, Ren et al. 2016) both halves of every pair force are gathered and
+momentum is conserved.  The kernels weight i's own terms by
+omega_i = (delta_i - |xi|)^2 only where |xi| < delta_i.  Families are stored as
 
 * ``offsets`` (n_owned + 1,) int64 and ``nbr`` (n_bonds,) int32 local indices,
 * each family sorted by the neighbour's **global id**,
@@ -77,10 +81,10 @@ def build_families(x: np.ndarray, gid: np.ndarray, horizon: np.ndarray, n_owned:
     for s in range(0, n_owned, chunk):
         e = min(n_owned, s + chunk)
         sub = cKDTree(x[s:e])
-        m = sub.sparse_distance_matrix(tree, float(horizon[s:e].max()), output_type="ndarray")
+        m = sub.sparse_distance_matrix(tree, float(horizon.max()), output_type="ndarray")
         i = m["i"]
         j = m["j"]
-        keep = (m["v"] < horizon[i + s]) & (i + s != j)
+        keep = (m["v"] < np.maximum(horizon[i + s], horizon[j])) & (i + s != j)
         c, nb = _csr_by_row(i[keep], j[keep], gid, e - s)
         counts.append(c)
         nbrs.append(nb)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .schema import Registry, fail, join, ordered_box, positive
+from .schema import Registry, fail, join, non_negative, ordered_box, positive
 
 INITIAL = Registry("initial condition", "kind")
 BOUNDARIES = Registry("boundary condition", "kind")
@@ -67,6 +67,31 @@ class UniformVelocity:
 
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         v[self.region.contains(x)] += np.asarray(self.velocity)
+
+
+@INITIAL.register("radial_velocity")
+@dataclass(frozen=True)
+class RadialVelocity:
+    """v = ``speed`` * e_r (radial in the x-y plane about ``center``) for points with
+    ``r_inner`` <= r <= ``r_outer``: the initial radial velocity of a borehole
+    wall, one of the simple blast loads of paper §3.1."""
+    center: tuple[float, float]
+    r_inner: float
+    r_outer: float
+    speed: float
+
+    def check(self, path):
+        non_negative(self, path, "r_inner")
+        if not self.r_outer > self.r_inner:
+            fail(join(path, "r_outer"), "must exceed r_inner")
+
+    def apply(self, x: np.ndarray, v: np.ndarray) -> None:
+        dx = x[:, 0] - self.center[0]
+        dy = x[:, 1] - self.center[1]
+        r = np.hypot(dx, dy)
+        sel = (r >= self.r_inner) & (r <= self.r_outer) & (r > 0)
+        v[sel, 0] += self.speed * dx[sel] / r[sel]
+        v[sel, 1] += self.speed * dy[sel] / r[sel]
 
 
 @BOUNDARIES.register("fixed")

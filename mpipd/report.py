@@ -67,6 +67,12 @@ def check_report(scene, ranks: int) -> str:
                    f"({p.horizon_factor:g} dx), {npts} points, {fam} bonds per bulk point")
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
+    for name, mat in scene.materials.items():
+        region = getattr(mat, "negative_tangent", lambda: None)()
+        if region is not None:
+            out.append(f"  material {name!r}: EOS tangent dp/dmu < 0 for mu in "
+                       f"{region[0]:.5f}..{region[1]:.5f} (K2 = {mat.K2:.4g} Pa, "
+                       f"K3 = {mat.K3:.4g} Pa): the wave speed and the viscosity use K1 there")
     out.append(f"  total: {table.n_points} points, <= {total_bonds} bonds "
                f"(bulk families; surface points have fewer)")
     dt_max = min(dt_limits)

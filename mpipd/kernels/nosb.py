@@ -34,13 +34,20 @@ from .viscosity import viscous_bond
 
 
 @numba.njit(cache=True, inline="always")
+def influence(delta, r):
+    """omega = (delta - r)^2 inside the horizon, 0 outside."""
+    w = delta - r
+    return w * w if w > 0.0 else 0.0
+
+
+@numba.njit(cache=True, inline="always")
 def bond(x, i, j, delta):
-    """Reference bond xi = x_j - x_i and omega = (delta - |xi|)^2 (no volume)."""
+    """Reference bond xi = x_j - x_i, |xi| and omega_i (no volume)."""
     e0 = x[j, 0] - x[i, 0]
     e1 = x[j, 1] - x[i, 1]
     e2 = x[j, 2] - x[i, 2]
-    w = delta - math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    return e0, e1, e2, w * w
+    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    return e0, e1, e2, r, influence(delta, r)
 
 
 @numba.njit(cache=True)
@@ -62,7 +69,9 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, gamma, sprin
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
-            e0, e1, e2, w = bond(x, i, nbr[b], di)
+            e0, e1, e2, r, w = bond(x, i, nbr[b], di)
+            if w == 0.0:
+                continue
             w *= vol[nbr[b]]
             g += w
             k00 += w * e0 * e0
@@ -125,8 +134,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
             e1 = x[j, 1] - xi1
             e2 = x[j, 2] - xi2
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = di - r
-            w = w * w * vol[j]
+            w = influence(di, r) * vol[j]
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
@@ -252,20 +260,17 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
                     fz += g * y2 * vj
                 continue
             tx = ty = tz = 0.0
-            wi = di - r
-            wi = wi * wi
-            if si == 0.0:
-                tx = wi * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
-                ty = wi * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
-                tz = wi * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
-            else:
-                g = _spring(cbb[i], r, y0, y1, y2)
-                tx, ty, tz = g * y0, g * y1, g * y2
-            dj = horizon[j]
-            wj = 0.0
-            if r < dj:
-                wj = dj - r
-                wj = wj * wj
+            wi = influence(di, r)
+            if wi > 0.0:
+                if si == 0.0:
+                    tx = wi * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
+                    ty = wi * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
+                    tz = wi * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
+                else:
+                    g = _spring(cbb[i], r, y0, y1, y2)
+                    tx, ty, tz = g * y0, g * y1, g * y2
+            wj = influence(horizon[j], r)
+            if wj > 0.0:
                 if fd[j, 10] == 0.0:
                     tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)
                     ty += wj * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, 9] * y1)
@@ -314,7 +319,7 @@ def hourglass_energy(x, u, vol, horizon, offsets, nbr, broken, F, fd, spring):
             if broken[k]:
                 continue
             j = nbr[k]
-            e0, e1, e2, w = bond(x, i, j, di)
+            e0, e1, e2, r, w = bond(x, i, j, di)
             z0 = e0 + u[j, 0] - u[i, 0] - (F[i, 0, 0] * e0 + F[i, 0, 1] * e1 + F[i, 0, 2] * e2)
             z1 = e1 + u[j, 1] - u[i, 1] - (F[i, 1, 0] * e0 + F[i, 1, 1] * e1 + F[i, 1, 2] * e2)
             z2 = e2 + u[j, 2] - u[i, 2] - (F[i, 2, 0] * e0 + F[i, 2, 1] * e1 + F[i, 2, 2] * e2)

@@ -78,6 +78,7 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
         pressure[k] = p
         if p < -T:
             mode[i] = MODE_TENSILE
+            pressure[k] = 0.0
             for c in range(6):
                 sigma[i, c] = 0.0
             continue
@@ -117,6 +118,7 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
             if D_new >= 1.0:
                 D[k] = 1.0
                 mode[i] = MODE_PLASTIC
+                pressure[k] = 0.0
                 for c in range(6):
                     sigma[i, c] = 0.0
                 continue

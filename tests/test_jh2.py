@@ -1,0 +1,168 @@
+"""JH2 single-point driver (no peridynamics): prescribed rate histories through
+the material kernel, checked against values computed here from Eqs. 19–36 and
+Table 1 (independently of the kernel's code path)."""
+import math
+
+import numpy as np
+import pytest
+
+from mpipd.materials.jh2 import JH2, jh2_pressure
+from mpipd.schema import build
+
+M = JH2()                                # Table 1 granite
+G, K1, K2, K3 = M.shear_modulus, M.bulk_modulus, M.K2, M.K3
+SHEL = 1.5 * (4.5e9 - 3.7e9)             # 1.2 GPa
+PHEL = 3.7e9
+TS = 54e6 / PHEL
+
+
+def strength(p, edot, D, A=1.9, N=0.62, B=0.25, Mx=0.62, C=0.005):
+    """sigma_y (Pa) from Eqs. 21–23, written out here."""
+    ps = p / PHEL
+    rate = 1 + C * math.log(max(edot, 1.0))
+    si = A * (ps + TS) ** N * rate
+    sf = B * ps ** Mx * rate if ps > 0 else 0.0
+    return SHEL * (si - D * (si - sf))
+
+
+class Point:
+    """One JH2 point driven by a prescribed d (Voigt) and J history."""
+
+    def __init__(self, mat=M):
+        self.mat = mat
+        self.sigma = np.zeros((1, 6))
+        self.mode = np.zeros(1, np.uint8)
+        self.state = mat.new_state(1)
+        self.idx = np.zeros(1, np.int64)
+
+    def step(self, d, J, dt):
+        self.mat.update(self.idx, np.asarray(d, float)[None], np.array([J]), dt,
+                        self.sigma, self.mode, self.state)
+
+    @property
+    def seq(self):
+        s = self.sigma[0]
+        m = s[:3].mean()
+        dev = np.array([s[0] - m, s[1] - m, s[2] - m])
+        return math.sqrt(1.5 * (dev @ dev + 2 * (s[3:] @ s[3:])))
+
+
+def test_eos_matches_eq25():
+    for mu in (-0.003, -1e-4, 0.0, 1e-4, 0.003, 0.005, 0.01):
+        want = K1 * mu + (K2 * mu ** 2 + K3 * mu ** 3 if mu >= 0 else 0.0)
+        assert jh2_pressure(mu, K1, K2, K3) == pytest.approx(want, rel=1e-14, abs=1e-6)
+
+
+def test_negative_tangent_region_of_table1():
+    roots = np.sort(np.roots([3 * K3, 2 * K2, K1]).real)
+    lo, hi = M.negative_tangent()
+    assert lo == pytest.approx(roots[0]) and hi == pytest.approx(roots[1])
+    assert 0.0041 < lo < 0.0043 and 0.0057 < hi < 0.0059
+    assert build(JH2, {"K2": 0.0}).negative_tangent() is None
+
+
+def test_uniaxial_strain_compression_elastic_slope():
+    pt = Point()
+    rate, dt, n = -100.0, 1e-8, 100            # eps_xx = -1e-4 in total: stays elastic
+    eps = 0.0
+    for _ in range(n):
+        eps += rate * dt
+        J = 1.0 + eps                          # uniaxial strain: J = 1 + eps_xx
+        pt.step([rate, 0, 0, 0, 0, 0], J, dt)
+    mu = 1.0 / (1.0 + eps) - 1.0
+    p = K1 * mu + K2 * mu ** 2 + K3 * mu ** 3
+    sxx = 2 * G * (2 / 3) * eps                # deviator of diag(eps, 0, 0)
+    assert pt.sigma[0, 0] == pytest.approx(sxx - p, rel=1e-9)
+    assert pt.sigma[0, 1] == pytest.approx(-G * (2 / 3) * eps - p, rel=1e-9)
+    assert pt.state["D"][0] == 0.0 and pt.mode[0] == 0
+
+
+def shear_run(mu, gdot, dt, beta=0.5, steps=400000, D1=0.005):
+    """Pure shear at fixed compression mu; returns the history of (seq, D, eps_p, dp, p, mode)."""
+    mat = build(JH2, {"beta": beta, "D1": D1})
+    pt = Point(mat)
+    J = 1.0 / (1.0 + mu)
+    hist = []
+    for _ in range(steps):
+        pt.step([0, 0, 0, 0, 0, gdot], J, dt)
+        hist.append((pt.seq, pt.state["D"][0], pt.state["eps_p"][0], pt.state["dp"][0],
+                     pt.state["pressure"][0], pt.mode[0]))
+        if pt.mode[0]:
+            break
+    return pt, np.array(hist)
+
+
+def test_yield_at_jh2_strength_for_given_pressure_and_rate():
+    mu, gdot, dt = 0.002, 2000.0, 2e-9
+    pt, h = shear_run(mu, gdot, dt, steps=3000)
+    p = K1 * mu + K2 * mu ** 2 + K3 * mu ** 3
+    edot = 2 / math.sqrt(3) * gdot             # Eq. 24 for pure shear d_xy = gdot
+    sy = strength(p, edot, 0.0)
+    seq = h[:, 0]
+    first = int(np.argmax(h[:, 2] > 0))        # first plastic step
+    assert first > 0
+    # elastic slope: seq = sqrt(3) * 2 G gdot t before yield
+    np.testing.assert_allclose(seq[:first], math.sqrt(3) * 2 * G * gdot * dt * np.arange(1, first + 1),
+                               rtol=1e-9)
+    # yields exactly at sigma_y: the last elastic value is below, the returned value is on it
+    assert seq[first - 1] <= sy + 1.0
+    assert seq[first] == pytest.approx(sy, rel=1e-9)  # returned onto sigma_y(D = 0)
+    incr = math.sqrt(3) * 2 * G * gdot * dt
+    assert sy - incr <= seq[first - 1] <= sy
+
+
+def test_damage_reaches_one_at_failure_strain_and_strength_falls():
+    # With Table 1's D1 = 0.005 the granite snaps: the strength drop of one damage
+    # increment releases more plastic strain than eps_f.  D1 = 0.4 (the top of the
+    # paper's literature range) lets damage accumulate over many steps.
+    mu, gdot, dt = 0.002, 2000.0, 2e-8
+    pt, h = shear_run(mu, gdot, dt, beta=0.0, D1=0.4)   # beta = 0: no bulking, p stays fixed
+    p = K1 * mu + K2 * mu ** 2 + K3 * mu ** 3
+    eps_f = 0.4 * (p / PHEL + TS) ** 0.7             # Eq. 30
+    assert np.count_nonzero(h[:, 2] > 0) > 100
+    assert pt.mode[0] == 1                           # failed by D >= 1
+    eps_p = h[:, 2]
+    assert eps_p[-2] < eps_f <= eps_p[-1] + 1e-15
+    # D = eps_p / eps_f along the way (Eq. 29)
+    plastic = eps_p > 0
+    np.testing.assert_allclose(h[plastic, 1][:-1], eps_p[plastic][:-1] / eps_f, rtol=1e-9)
+    # on the yield surface, the strength follows Eq. 21 with the current D
+    edot = 2 / math.sqrt(3) * gdot
+    k = np.flatnonzero(plastic)[len(np.flatnonzero(plastic)) // 2]
+    assert h[k, 0] == pytest.approx(strength(p, edot, h[k - 1, 1]), rel=1e-9)
+    # and falls towards the fractured strength
+    assert h[-2, 0] < 0.7 * strength(p, edot, 0.0)
+    assert strength(p, edot, 1.0) < h[-2, 0]
+
+
+def test_bulking_follows_eq26():
+    mu, gdot, dt = 0.002, 2000.0, 2e-9
+    pt, h = shear_run(mu, gdot, dt, beta=0.5, steps=2000)
+    p_eos = K1 * mu + K2 * mu ** 2 + K3 * mu ** 3
+    edot = 2 / math.sqrt(3) * gdot
+    plastic = np.flatnonzero((h[:, 2] > 0) & (h[:, 5] == 0))   # plastic, not the failure step
+    assert len(plastic) > 10 and h[plastic[-1], 3] > 0
+    for k in plastic[1:]:
+        D0, D1, dp0 = h[k - 1, 1], h[k, 1], h[k - 1, 3]
+        ps = p_eos + dp0
+        dU = (strength(ps, edot, D0) ** 2 - strength(ps, edot, D1) ** 2) / (6 * G)
+        want = -K1 * mu + math.sqrt((K1 * mu + dp0) ** 2 + 2 * 0.5 * K1 * dU)
+        assert h[k, 3] == pytest.approx(want, rel=1e-9)
+        assert h[k, 4] == pytest.approx(p_eos + want, rel=1e-12)
+
+
+def test_hydrostatic_tension_fails_at_minus_T():
+    pt = Point()
+    dt = 1e-8
+    for k in range(1, 10000):
+        J = 1.0 + 1e-6 * k                       # expansion: mu < 0, p = K1 mu
+        pt.step([0, 0, 0, 0, 0, 0], J, dt)
+        p = K1 * (1.0 / J - 1.0)
+        if p < -54e6:
+            assert pt.mode[0] == 2               # JH2 tensile, this very step
+            assert np.all(pt.sigma == 0.0)
+            break
+        assert pt.mode[0] == 0
+        assert pt.sigma[0, 0] == pytest.approx(-p, rel=1e-12)
+    else:
+        pytest.fail("never reached -T")
