@@ -109,6 +109,7 @@ def _run(args, team) -> int:
     from . import scene as sc
     from .decomp import DecompositionError
     from .output import Writer
+    from .report import stable_dt
     from .schema import SceneError
     from .solver import Progress, Simulation
 
@@ -131,6 +132,10 @@ def _run(args, team) -> int:
         print(f"mpipd: {scene.name}: {sim.n_global} points, {sim.n_bonds_global} bonds, "
               f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}",
               flush=True)
+        dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
+        if scene.time.dt > dt_stable:
+            print(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
+                  f"{dt_stable:.4e} s (see `mpipd check`); the run may blow up", flush=True)
         if sim.n_spring_global:
             print(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
                   "(shape tensor not invertible)", flush=True)
@@ -140,11 +145,17 @@ def _run(args, team) -> int:
     wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress)
     writer.close()
     n_spring = sim.spring_points()
+    failed = sim.failure_counts()
+    broken = sim.bonds_broken()
     if team.root:
         rate = sim.n_bonds_global * n_steps / max(wall, 1e-12)
         print(f"mpipd: done in {wall:.2f} s: {rate / 1e6:.2f} M bond-steps/s, "
-              f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}; "
-              f"wrote {h5} and {h5.with_suffix('.xdmf')}", flush=True)
+              f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}",
+              flush=True)
+        if sim.failure is not None:
+            print(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
+                  f"{failed[3]} tension model; {broken} bonds broken", flush=True)
+        print(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}", flush=True)
     return 0
 
 

@@ -56,6 +56,18 @@ class Box:
     def z_levels(self, dx):
         return _cells(self.lo[2], self.hi[2], dx)
 
+    @property
+    def z_range(self):
+        return self.lo[2], self.hi[2]
+
+    @property
+    def area(self):
+        return (self.hi[0] - self.lo[0]) * (self.hi[1] - self.lo[1])
+
+    def contains_xy(self, x, y, margin):
+        return ((x > self.lo[0] + margin) & (x < self.hi[0] - margin)
+                & (y > self.lo[1] + margin) & (y < self.hi[1] - margin))
+
     def cross_section(self, dx):
         xs = _cells(self.lo[0], self.hi[0], dx)
         ys = _cells(self.lo[1], self.hi[1], dx)
@@ -78,6 +90,20 @@ class Cylinder:
 
     def z_levels(self, dx):
         return _cells(self.z[0], self.z[1], dx)
+
+    @property
+    def z_range(self):
+        return self.z
+
+    @property
+    def area(self):
+        return np.pi * self.radius ** 2
+
+    def _r(self, x, y):
+        return np.hypot(x - self.center[0], y - self.center[1])
+
+    def contains_xy(self, x, y, margin):
+        return self._r(x, y) < self.radius - margin
 
     def _ring(self, dx, r_in, r_out):
         o = _centred(r_out, dx)
@@ -102,6 +128,14 @@ class Annulus(Cylinder):
         if not self.inner_radius < self.radius:
             fail(join(path, "inner_radius"), "must be smaller than radius")
 
+    @property
+    def area(self):
+        return np.pi * (self.radius ** 2 - self.inner_radius ** 2)
+
+    def contains_xy(self, x, y, margin):
+        r = self._r(x, y)
+        return (r > self.inner_radius + margin) & (r < self.radius - margin)
+
     def cross_section(self, dx):
         return self._ring(dx, self.inner_radius, self.radius)
 
@@ -124,6 +158,8 @@ class LayerTable:
 
     @classmethod
     def from_parts(cls, parts, material_ids) -> "LayerTable":
+        """The layer table; refuses parts that are empty, absurdly large or overlapping."""
+        check_parts(parts)
         zs, ps, ms, cs = [], [], [], []
         for p, part in enumerate(parts):
             z = part.shape.z_levels(part.dx)
@@ -137,6 +173,36 @@ class LayerTable:
         count = count[order].astype(np.int64)
         start = np.concatenate(([0], np.cumsum(count)[:-1])).astype(np.int64)
         return cls(z=z[order], part=part[order], count=count, start=start)
+
+
+#: most lattice points one cross-section may have (a layer is generated whole)
+MAX_SECTION_POINTS = 50_000_000
+
+
+def check_parts(parts) -> None:
+    """Each part yields points, no section is absurdly large, no two parts overlap."""
+    sections = []
+    for k, part in enumerate(parts):
+        est = part.shape.area / part.dx ** 2
+        if est > MAX_SECTION_POINTS:
+            fail(f"parts[{k}].dx", f"gives ~{est:.3g} points per z level "
+                                   f"(at most {MAX_SECTION_POINTS:.0e}); dx is too small")
+        x, y = part.shape.cross_section(part.dx)
+        if len(x) == 0:
+            fail(f"parts[{k}].shape", f"part {part.name!r} holds no lattice point at "
+                                      f"dx = {part.dx} (shape smaller than the lattice)")
+        sections.append((x, y))
+    for a in range(len(parts)):
+        for b in range(len(parts)):
+            if a == b:
+                continue
+            za, zb = parts[a].shape.z_range, parts[b].shape.z_range
+            margin = 0.25 * min(parts[a].dx, parts[b].dx)
+            if max(za[0], zb[0]) >= min(za[1], zb[1]) - margin:
+                continue
+            x, y = sections[a]
+            if np.any(parts[b].shape.contains_xy(x, y, margin)):
+                fail(f"parts[{a}]", f"part {parts[a].name!r} overlaps part {parts[b].name!r}")
 
 
 def fill_layers(parts, table: LayerTable, layers: np.ndarray):

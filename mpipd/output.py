@@ -146,6 +146,8 @@ class Writer:
 
     def close(self):
         self.f.attrs["frames_written"] = self.frame_no
+        self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
+        self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()
         self.f.close()
         if self.sim.team.root:
             write_xdmf(self.path, self.sim.n_global, self.fields, self.frame_no,

@@ -20,11 +20,29 @@ from .decomp import decompose, halo_width
 from .geometry import LayerTable
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
-#: allocates (``tests/test_memory.py`` checks it)
-BYTES_PER_LOCAL_POINT = 208     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb
+#: allocates (``tests/test_memory.py`` checks it against a walk of every array)
+BYTES_PER_LOCAL_POINT = 209     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb, mode
 BYTES_PER_OWNED_POINT = 642     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group index
 BYTES_PER_BOND = 5              # nbr (int32) + broken (uint8)
+FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
+DAMPING_OWNED = 8
+VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 24
+JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
+
+
+def memory_model(scene) -> tuple[int, int]:
+    """(bytes per local point, extra bytes per owned point) for the scene's features."""
+    local, owned = BYTES_PER_LOCAL_POINT, BYTES_PER_OWNED_POINT
+    if scene.can_fail:
+        local += FAILURE_LOCAL
+        owned += FAILURE_OWNED + (DAMPING_OWNED if scene.solver.damping > 0 else 0)
+    if scene.solver.viscosity is not None:
+        local += VISCOSITY_LOCAL
+        owned += VISCOSITY_OWNED
+    if scene.has_model("jh2"):
+        owned += JH2_OWNED            # an upper bound when only some parts are JH2
+    return local, owned
 
 
 def bulk_family(dx: float, horizon: float) -> np.ndarray:
@@ -79,6 +97,7 @@ def check_report(scene, ranks: int) -> str:
     verdict = "OK" if scene.time.dt <= dt_max else "TOO LARGE - the run will be unstable"
     out.append(f"  time step: dt = {scene.time.dt:.4e} s vs stable {dt_max:.4e} s "
                f"(ratio {scene.time.dt / dt_max:.2f}): {verdict}")
+    per_local, per_owned = memory_model(scene)
     out.append(f"  decomposition: {ranks} rank(s) along z, halo = {halo:.4g} m "
                "(largest horizon + dx/2)")
     for r in range(ranks):
@@ -87,8 +106,7 @@ def check_report(scene, ranks: int) -> str:
         a, b = slabs.owned(r)
         layers = np.arange(a, b)
         bonds = int(sum(table.count[L] * family[int(table.part[L])] for L in layers))
-        mem = (BYTES_PER_LOCAL_POINT * (owned + ghost) + BYTES_PER_OWNED_POINT * owned
-               + BYTES_PER_BOND * bonds)
+        mem = (per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * bonds)
         thick = z1 - z0 + float(scene.max_dx)
         recv, _ = slabs.plan(r)
         peers = len(recv)

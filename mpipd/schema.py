@@ -16,6 +16,7 @@ condition's ``kind``) are resolved through a :class:`Registry`, never through
 from __future__ import annotations
 
 import dataclasses
+import math
 import types
 import typing
 
@@ -105,6 +106,8 @@ def _coerce(tp, value, path):
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             fail(path, f"expected a number, got {_tname(value)} {value!r}")
+        if not math.isfinite(value):
+            fail(path, f"must be a finite number (got {value!r})")
         return float(value)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):

@@ -129,30 +129,58 @@ class Simulation:
         ke = integrate.kinetic_energy(self.v, self.rho, self.points.volume[:n])
         local = np.array([ke, self.corr.strain_energy(), self.corr.hourglass_energy(self.u)])
         tot = self.team.sum(local)
+        if not np.all(np.isfinite(tot)):
+            raise FloatingPointError(
+                f"non-finite energy at step {self.step_count} (t = {self.t:.4e} s): the run "
+                "went unstable; compare dt with the stable step of `mpipd check`")
         return Energies(*map(float, tot))
+
+    def bonds_broken(self) -> int:
+        return self.team.sum(self.failure.bonds_broken) if self.failure else 0
+
+    def failure_counts(self) -> np.ndarray:
+        """Failed owned points per mode over all ranks (index = mode, 0 = intact)."""
+        if self.failure is None:
+            return np.array([self.n_global, 0, 0, 0])
+        return self.team.sum(self.failure.counts())
 
     def spring_points(self) -> int:
         return self.team.sum(self.corr.n_spring)
 
     def memory(self) -> dict:
-        """Bytes held by this rank: per-bond arrays, per-point arrays, and totals."""
-        bond = self.families.nbr.nbytes + self.families.broken.nbytes
-        arrays = [self.u, self.v, self.a, self.f, self.rho, self.fixed, self.families.offsets]
-        arrays += [getattr(self.points, k) for k in
-                   ("x", "gid", "part", "material", "volume", "horizon", "dx")]
-        c = self.corr
-        arrays += [c.Kinv, c.trK, c.spring, c.F, c.F_old, c.Fdot, c.R, c.V, c.sigma, c.d,
-                   c.J, c.W, c.fd, c.hg_modulus, c.cbb]
-        arrays += [c.gamma, c.dil]
-        if self.failure is not None:
-            fl = self.failure
-            arrays += [fl.mode, fl.done, fl.phi, fl.touched, fl.damp]
-        for g in c.groups:
-            arrays += list(g.state.values()) + [g.idx]
-        point = sum(a.nbytes for a in arrays)
-        nb = max(1, self.families.n_bonds)
-        return {"bond_bytes": bond, "point_bytes": point, "bytes_per_bond": bond / nb,
-                "bytes_per_point": point / max(1, self.points.n_local)}
+        """Bytes held by this rank, found by walking every NumPy array the simulation
+        owns (so nothing can be left out): per-bond arrays, the rest, and totals."""
+        seen, arrays = set(), []
+
+        def walk(obj, depth=0):
+            if depth > 8 or id(obj) in seen:
+                return
+            seen.add(id(obj))
+            if isinstance(obj, np.ndarray):
+                if obj.base is None or not isinstance(obj.base, np.ndarray):
+                    arrays.append(obj)
+                return
+            if isinstance(obj, dict):
+                for v in obj.values():
+                    walk(v, depth + 1)
+            elif isinstance(obj, (list, tuple)):
+                for v in obj:
+                    walk(v, depth + 1)
+            elif hasattr(obj, "__dict__") and obj.__class__.__module__.startswith("mpipd"):
+                for v in vars(obj).values():
+                    walk(v, depth + 1)
+
+        walk(self)
+        fam = self.families
+        bond = fam.nbr.nbytes + fam.broken.nbytes
+        point = sum(a.nbytes for a in arrays) - bond
+        tree = 0
+        if self.failure is not None:                # the reference-position search tree
+            tree = self.failure.tree.data.nbytes + self.failure.tree.indices.nbytes
+        nb = max(1, fam.n_bonds)
+        return {"bond_bytes": bond, "point_bytes": point, "tree_bytes": tree,
+                "bytes_per_bond": bond / nb,
+                "bytes_per_point": (point + tree) / max(1, self.points.n_local)}
 
     # ------------------------------------------------------------------ time loop
     def run(self, n_steps: int, writer=None, every: int = 0, progress=None) -> float:

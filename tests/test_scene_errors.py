@@ -77,3 +77,31 @@ def test_bad_scene_under_mpirun_one_message(tmp_path):
     res = run_cli(["run", "elastic_wave", "--out", str(out), "--set", "parts.0.dx=0"],
                   ranks=2, timeout=120)
     check_bad(res, out, "parts[0].dx", "must be > 0", mpirun=True)
+
+
+GEOMETRY_CASES = [
+    (["--set", "time.dt=inf"], "time.dt", "finite"),
+    (["--set", "parts.0.dx=nan"], "parts[0].dx", "finite"),
+    (["--set", "parts.0.shape.lo=[0,0,nan]"], "parts[0].shape.lo[2]", "finite"),
+    (["--set", "parts.0.dx=1e-9"], "parts[0].dx", "too small"),
+    (["--set", 'parts.0.shape={kind="cylinder", center=[0,0], radius=1e-4, z=[0,0.01]}'],
+     "parts[0].shape", "no lattice point"),
+]
+
+
+@pytest.mark.parametrize("args,key,reason", GEOMETRY_CASES)
+def test_bad_numbers_and_geometry(tmp_path, args, key, reason):
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", "elastic_wave", "--out", str(out), *args]), out, key, reason)
+    res = run_cli(["check", "elastic_wave", *args])
+    assert res.returncode == 2 and key in res.stderr
+
+
+def test_overlapping_parts(tmp_path):
+    text = sc.builtin_scenes()["elastic_wave"].read_text()
+    text += ('\n[[parts]]\nname = "bar2"\nmaterial = "granite"\ndx = 1.0e-3\n'
+             'shape = { kind = "box", lo = [0.1, 0.0, 0.0], hi = [0.3, 0.016, 0.016] }\n')
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", str(f), "--out", str(out)]), out, "overlaps")

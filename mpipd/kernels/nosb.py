@@ -113,7 +113,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
     N = np.empty((3, 3))
     Nd = np.empty((3, 3))
     for i in range(n):
-        if spring[i]:
+        if spring[i] == 1:                     # K not invertible: no F at all
             for r in range(3):
                 for c in range(3):
                     F[i, r, c] = 1.0 if r == c else 0.0
@@ -181,9 +181,10 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
     """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
     fd[i, 9] = h, fd[i, 10] = 1.0 for a bond-spring point, else 0.0, with A = J sigma F^-T K^-1, sigma = R sigma_unrot R^T, h = 2 M / tr K.
 
-    ``hg_modulus[i]`` is c * M of the point's material.  Points whose K or F
-    cannot be inverted switch to the bond-spring fallback (``spring[i] = 1``).
-    Returns the number of points whose F turned singular this call.
+    ``hg_modulus[i]`` is c * M of the point's material.  Points whose K cannot
+    be inverted (``spring[i] = 1``, set by shape_tensors) use the bond-spring
+    fallback; so, for this step only, does a point whose F is singular or not
+    finite (``spring[i] = 2``, re-tested every step).  Returns how many those are.
     """
     n_owned = F.shape[0]
     S = np.empty((3, 3))
@@ -193,10 +194,12 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
     P = np.empty((3, 3))
     n_bad = 0
     for i in range(n_owned):
-        if spring[i] == 0:
+        if spring[i] != 1:
             J = det3(F[i])
-            if not J > 0.0:
-                spring[i] = 2          # singular F this step
+            if J > 0.0 and math.isfinite(J):
+                spring[i] = 0
+            else:
+                spring[i] = 2          # singular (or non-finite) F this step
                 n_bad += 1
         if spring[i]:
             for c in range(10):

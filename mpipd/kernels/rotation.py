@@ -22,7 +22,7 @@ import math
 import numba
 import numpy as np
 
-from .linalg import inv3, mat_to_voigt, mul3, mul3_at
+from .linalg import det3, inv3, mat_to_voigt, mul3, mul3_at
 
 
 @numba.njit(cache=True)
@@ -41,14 +41,15 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J):
     Dm = np.empty((3, 3))
     Vn = np.empty((3, 3))
     for i in range(n):
-        if spring[i]:
-            for c in range(6):
-                d[i, c] = 0.0
-            J[i] = 1.0
-            continue
         for r in range(3):
             for c in range(3):
                 Fm[r, c] = 0.5 * (F_old[i, r, c] + F_new[i, r, c])
+        Jm = det3(Fm)
+        if spring[i] == 1 or not (Jm > 0.0 and math.isfinite(Jm)):
+            for c in range(6):                  # no continuum kinematics this step
+                d[i, c] = 0.0
+            J[i] = 1.0
+            continue
         J[i] = inv3(Fm, Fi)
         mul3(Fdot[i], Fi, L)
         for r in range(3):
