@@ -12,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install demo test verify bench clean
+.PHONY: install demo test bench clean
 
 install: $(STAMP)
 
@@ -21,7 +21,7 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 	touch $@
 
 demo: install
-	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run elastic_wave --out runs/demo --overwrite
+	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run granite_ring --out runs/demo --overwrite
 	@echo "demo: wrote runs/demo/run.h5 and runs/demo/run.xdmf (open the .xdmf in ParaView)"
 
 test: install
