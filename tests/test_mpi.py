@@ -26,16 +26,20 @@ def test_exception_on_one_rank_aborts_the_job():
     assert "deliberate failure on rank 1" in res.stderr
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    base = tmp_path_factory.mktemp("runs")
+def run_on_1_2_3(base, scene, args):
+    """Run ``scene`` on 1, 2 and 3 ranks; returns {ranks: run.h5}."""
     out = {}
     for n in (1, 2, 3):
         d = base / f"n{n}"
-        res = run_cli(["run", "elastic_wave", "--out", str(d), *SMALL], ranks=n, timeout=300)
+        res = run_cli(["run", scene, "--out", str(d), *args], ranks=n, timeout=600)
         assert res.returncode == 0, res.stdout + res.stderr
         out[n] = d / "run.h5"
     return out
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    return run_on_1_2_3(tmp_path_factory.mktemp("runs"), "elastic_wave", SMALL)
 
 
 def test_decomposition_invariance_bitwise(runs):
@@ -78,14 +82,7 @@ FRACTURE = ["--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=8e-6",
 
 @pytest.fixture(scope="module")
 def fracture_runs(tmp_path_factory):
-    base = tmp_path_factory.mktemp("frac")
-    out = {}
-    for n in (1, 2, 3):
-        d = base / f"n{n}"
-        res = run_cli(["run", "granite_ring", "--out", str(d), *FRACTURE], ranks=n, timeout=600)
-        assert res.returncode == 0, res.stdout + res.stderr
-        out[n] = d / "run.h5"
-    return out
+    return run_on_1_2_3(tmp_path_factory.mktemp("frac"), "granite_ring", FRACTURE)
 
 
 def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
