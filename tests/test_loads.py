@@ -56,3 +56,12 @@ def test_override_parsing():
     assert scene.initial[0].velocity == (2.0, 0.0, 0.0)
     assert scene.name == "renamed"
     assert scene.parts[0].shape.hi == (0.1, 0.01, 0.01)
+
+
+def test_check_reports_negative_tangent_eos():
+    res = run_cli(["check", "granite_ring"])
+    assert res.returncode == 0, res.stderr
+    line = [ln for ln in res.stdout.splitlines() if "tangent" in ln]
+    assert line and "0.00418..0.00582" in line[0]
+    res = run_cli(["check", "granite_ring", "--set", "materials.granite.K2=0.0"])
+    assert "tangent" not in res.stdout
