@@ -42,7 +42,7 @@ OUTPUT_FIELDS = {
     "u": (3, None), "v": (3, None), "stress": (6, None), "strain_energy": (1, None),
     "damage": (1, "failure"),            # PD damage phi (Eq. 39)
     "failure_mode": (1, "failure"),      # 0 intact, 1 JH2 D >= 1, 2 JH2 p* < -T*, 3 tension model
-    "jh2_damage": (1, "jh2"), "pressure": (1, "jh2"), "plastic_strain": (1, "jh2"),
+    "jh2_damage": (1, "jh2"), "pressure": (1, "jh2"), "plastic_strain": (1, "plastic"),
     "strain_rate": (1, "jh2"),
 }
 
@@ -158,12 +158,13 @@ class Scene:
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
             names.add(p.name)
-        needs = {"failure": self.can_fail, "jh2": self.has_model("jh2")}
+        needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
+                 "plastic": self.has_model("jh2") or self.has_model("j2")}
         for i, f in enumerate(self.output.fields):
             need = OUTPUT_FIELDS[f][1]
             if need is not None and not needs[need]:
-                what = ("a material that can fail (jh2, or a tension model)" if need == "failure"
-                        else "a jh2 material")
+                what = {"failure": "a material that can fail (jh2, or a tension model)",
+                        "jh2": "a jh2 material", "plastic": "a jh2 or j2 material"}[need]
                 fail(f"output.fields[{i}]", f"{f!r} needs {what}")
 
     @property

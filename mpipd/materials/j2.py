@@ -1,0 +1,74 @@
+"""Elastic–perfectly-plastic von Mises (J2) solid: the paper's copper tube (§3.1).
+
+Hypoelastic trial stress in the unrotated frame (as :mod:`.elastic`), then a
+radial return of the deviator onto the yield surface:
+
+    S' = S + 2 G dev(d) dt,  s = sqrt(3/2 S':S');  if s > sigma_y:  S = (sigma_y / s) S',
+    deps_p = (s - sigma_y) / (3 G),
+
+with the pressure integrated elastically (K tr(d) dt); the paper applies no EOS
+to the copper.  Defaults: the paper's copper, rho 8960 kg/m^3, K 130 GPa,
+G 45 GPa, sigma_y 450 MPa.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from ..schema import positive
+from . import MATERIALS
+from .base import Material
+from .tension import TensionFailure
+
+
+@numba.njit(cache=True)
+def j2_update(idx, d, dt, sigma, mode, eps_p, K, G, sy):
+    s = np.empty(6)
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        if mode[i] != 0:
+            continue
+        tr = d[i, 0] + d[i, 1] + d[i, 2]
+        p_new = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0 + K * tr * dt
+        m = tr / 3.0
+        mean = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
+        for c in range(3):
+            s[c] = sigma[i, c] - mean + 2.0 * G * (d[i, c] - m) * dt
+        for c in range(3, 6):
+            s[c] = sigma[i, c] + 2.0 * G * d[i, c] * dt
+        seq = math.sqrt(1.5 * (s[0] ** 2 + s[1] ** 2 + s[2] ** 2
+                               + 2.0 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
+        if seq > sy:
+            f = sy / seq
+            for c in range(6):
+                s[c] *= f
+            eps_p[k] += (seq - sy) / (3.0 * G)
+        for c in range(3):
+            sigma[i, c] = s[c] + p_new
+        for c in range(3, 6):
+            sigma[i, c] = s[c]
+
+
+@MATERIALS.register("j2")
+@dataclass(frozen=True)
+class J2(Material):
+    """``density``, ``bulk_modulus``, ``shear_modulus``, ``yield_stress`` (Pa)."""
+    density: float = 8960.0
+    bulk_modulus: float = 130e9
+    shear_modulus: float = 45e9
+    yield_stress: float = 450e6
+    tension: TensionFailure | None = None
+
+    def check(self, path):
+        super().check(path)
+        positive(self, path, "yield_stress")
+
+    def new_state(self, n: int) -> dict:
+        return {"eps_p": np.zeros(n)}
+
+    def update(self, idx, d, J, dt, sigma, mode, state):
+        j2_update(idx, d, dt, sigma, mode, state["eps_p"], self.bulk_modulus,
+                  self.shear_modulus, self.yield_stress)

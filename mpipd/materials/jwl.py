@@ -1,0 +1,88 @@
+"""Jones–Wilkins–Lee equation of state of the detonation products (paper Eq. 48, Table 2).
+
+    p(V, e) = A (1 - w/(R1 V)) exp(-R1 V) + B (1 - w/(R2 V)) exp(-R2 V) + w e / V
+
+with V = rho0/rho the relative volume and e the internal energy per unit
+*initial* volume (J/m^3; e0 = 7.38 GJ/m^3 for the paper's explosive).
+
+Chapman–Jouguet state.  From the unreacted state (V = 1, p = 0, e = e0) the
+products' Hugoniot (energy jump e = e0 + p (1 - V)/2) is
+
+    p_H(V) = [f(V) + w e0 / V] / [1 - w (1 - V) / (2 V)],   f = the two exponential terms,
+
+and the Rayleigh line p = rho0 D^2 (1 - V) touches it where D is smallest:
+D_CJ = min_V sqrt(p_H(V) / (rho0 (1 - V))).  For Table 2 this gives
+D_CJ = 6688 m/s (the paper's VOD: 6690 m/s), p_CJ = 15.5 GPa, V_CJ = 0.737; the
+constant-volume explosion pressure p(1, e0) is 6.79 GPa.
+
+Isentropes of JWL are p_s(V) = A exp(-R1 V) + B exp(-R2 V) + C V^-(1 + w), with
+e_s(V) = (A/R1) exp(-R1 V) + (B/R2) exp(-R2 V) + (C/w) V^-w.
+
+This module is the EOS only.  The explosive gas as an updated-Lagrangian
+material (Eqs. 45–47, programmed detonation) builds on it and is not yet
+registered as a scene material.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+from scipy.optimize import minimize_scalar
+
+from ..schema import positive
+
+
+@numba.njit(cache=True, inline="always")
+def jwl_pressure(V, e, A, B, R1, R2, w):
+    """Eq. 48: pressure (Pa) at relative volume V and energy per initial volume e."""
+    return (A * (1.0 - w / (R1 * V)) * math.exp(-R1 * V)
+            + B * (1.0 - w / (R2 * V)) * math.exp(-R2 * V) + w * e / V)
+
+
+@dataclass(frozen=True)
+class JWL:
+    """Table 2 defaults (SI): rho0 1320 kg/m^3, A 568 GPa, B 21.6 GPa, R1 5.81,
+    R2 1.77, omega 0.282, e0 7.38e9 J/m^3, VOD 6690 m/s."""
+    density: float = 1320.0
+    A: float = 568e9
+    B: float = 21.6e9
+    R1: float = 5.81
+    R2: float = 1.77
+    omega: float = 0.282
+    e0: float = 7.38e9
+    vod: float = 6690.0
+
+    def check(self, path):
+        positive(self, path, "density", "A", "R1", "R2", "omega", "e0", "vod")
+
+    def pressure(self, V: float, e: float) -> float:
+        return jwl_pressure(V, e, self.A, self.B, self.R1, self.R2, self.omega)
+
+    def _f(self, V):
+        return (self.A * (1 - self.omega / (self.R1 * V)) * math.exp(-self.R1 * V)
+                + self.B * (1 - self.omega / (self.R2 * V)) * math.exp(-self.R2 * V))
+
+    def hugoniot_pressure(self, V: float) -> float:
+        """Products' Hugoniot from the unreacted state (V = 1, p = 0, e = e0)."""
+        w = self.omega
+        return (self._f(V) + w * self.e0 / V) / (1.0 - w * (1.0 - V) / (2.0 * V))
+
+    def chapman_jouguet(self) -> dict:
+        """CJ state: V, p, D (detonation speed) and e, from the Rayleigh-line tangency."""
+        def d2(V):
+            return self.hugoniot_pressure(V) / (self.density * (1.0 - V))
+        r = minimize_scalar(d2, bounds=(0.2, 0.999), method="bounded",
+                            options={"xatol": 1e-13})
+        V = float(r.x)
+        p = self.hugoniot_pressure(V)
+        return {"V": V, "p": p, "D": math.sqrt(d2(V)), "e": self.e0 + 0.5 * p * (1.0 - V)}
+
+    def isentrope_constant(self, V: float, p: float) -> float:
+        """C of the isentrope through (V, p)."""
+        return ((p - self.A * math.exp(-self.R1 * V) - self.B * math.exp(-self.R2 * V))
+                * V ** (1.0 + self.omega))
+
+    def isentrope_pressure(self, V: float, C: float) -> float:
+        return (self.A * math.exp(-self.R1 * V) + self.B * math.exp(-self.R2 * V)
+                + C * V ** -(1.0 + self.omega))
