@@ -1,9 +1,10 @@
 """Initial conditions and boundary conditions, resolved through registries.
 
 Initial conditions set the velocity field at t = 0 on the reference
-positions; boundary conditions mark points whose motion is prescribed.  Each
-entry of a scene's ``[[initial]]`` / ``[[boundaries]]`` arrays names its
-``kind``; adding a kind means registering one small dataclass here.
+positions; boundary conditions mark points whose motion is prescribed; loads
+apply time-dependent body forces.  Each entry of a scene's ``[[initial]]`` /
+``[[boundaries]]`` / ``[[loads]]`` arrays names its ``kind``; adding a kind
+means registering one small dataclass here.
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from .schema import Registry, fail, join, non_negative, ordered_box, positive
 
 INITIAL = Registry("initial condition", "kind")
 BOUNDARIES = Registry("boundary condition", "kind")
+LOADS = Registry("load", "kind")
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -102,3 +104,75 @@ class Fixed:
 
     def mask(self, x: np.ndarray) -> np.ndarray:
         return self.region.contains(x)
+
+
+@dataclass
+class PreparedLoad:
+    """A load bound to one rank's points: owned indices and force density per unit load."""
+    load: object
+    idx: np.ndarray          # owned points the load acts on
+    g: np.ndarray            # (len(idx), 3) body force density per unit of load.value(t)
+
+
+@LOADS.register("borehole_pressure")
+@dataclass(frozen=True)
+class BoreholePressure:
+    """Pressure history p(t) on a borehole wall (axis along z through ``center``,
+    wall radius ``radius``), applied as a radial body force on the wall's points —
+    one of the simple blast loads of paper §3.1.
+
+    History: ``p0``, ``alpha``, ``beta`` for the pulse p0 (e^-alpha t - e^-beta t), or
+    ``times`` and ``pressures`` for a table (linear in between, the last value after).
+
+    The wall's points are the first lattice layer, radius <= r < radius + dx.  The
+    force on the wall per z level, p 2 pi radius dx, is shared equally by that
+    level's layer points of each part, so the total force is exactly the pressure
+    times the wall area.
+    """
+    center: tuple[float, float]
+    radius: float
+    p0: float | None = None
+    alpha: float | None = None
+    beta: float | None = None
+    times: tuple[float, ...] | None = None
+    pressures: tuple[float, ...] | None = None
+
+    def check(self, path):
+        positive(self, path, "radius")
+        pulse = (self.p0, self.alpha, self.beta)
+        table = (self.times, self.pressures)
+        if all(v is not None for v in pulse) and all(v is None for v in table):
+            non_negative(self, path, "alpha", "beta")
+            if not self.beta > self.alpha:
+                fail(join(path, "beta"), "must exceed alpha (p0 (e^-alpha t - e^-beta t) >= 0)")
+        elif all(v is not None for v in table) and all(v is None for v in pulse):
+            if len(self.times) != len(self.pressures) or len(self.times) < 2:
+                fail(join(path, "times"), "times and pressures need the same length, >= 2")
+            if any(b <= a for a, b in zip(self.times, self.times[1:])):
+                fail(join(path, "times"), "must increase")
+        else:
+            fail(path, "give either p0, alpha, beta (pulse) or times, pressures (table)")
+
+    def value(self, t: float) -> float:
+        if self.p0 is not None:
+            return self.p0 * (np.exp(-self.alpha * t) - np.exp(-self.beta * t))
+        return float(np.interp(t, self.times, self.pressures))
+
+    def prepare(self, parts, points) -> PreparedLoad:
+        n = points.n_owned
+        x = points.x[:n]
+        dxy = x[:, :2] - np.asarray(self.center)
+        r = np.hypot(dxy[:, 0], dxy[:, 1])
+        dx = points.dx[:n]
+        layer = (r >= self.radius) & (r < self.radius + dx)
+        # layer points per z level of each part, from the part's cross-section
+        per_level = np.zeros(len(parts))
+        for k, part in enumerate(parts):
+            sx, sy = part.shape.cross_section(part.dx)
+            rr = np.hypot(sx - self.center[0], sy - self.center[1])
+            per_level[k] = np.count_nonzero((rr >= self.radius) & (rr < self.radius + part.dx))
+        idx = np.flatnonzero(layer)
+        share = 2.0 * np.pi * self.radius * dx[idx] / per_level[points.part[idx]]
+        g = np.zeros((len(idx), 3))
+        g[:, :2] = (share / points.volume[idx])[:, None] * dxy[idx] / r[idx, None]
+        return PreparedLoad(self, idx, g)

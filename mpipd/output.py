@@ -12,7 +12,7 @@ does not depend on the number of ranks that wrote it::
     /geometry/part          (N,)  part index (attrs: names)
     /fields/<name>          (n_frames, N[, k])   u, v, stress, strain_energy
     /time                   (n_frames,)
-    /energy/{t, kinetic, strain, hourglass, total}   (n_frames,)
+    /energy/{t, kinetic, strain, hourglass, total, external}   (n_frames,)
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
 ``run.xdmf`` beside the file opens the fields in ParaView.
@@ -120,7 +120,7 @@ class Writer:
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8")
         eg = self.f.create_group("energy")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8")
-                       for k in ("t", "kinetic", "strain", "hourglass", "total")}
+                       for k in ("t", "kinetic", "strain", "hourglass", "total", "external")}
 
     @staticmethod
     def _write(dset, sel, data):
@@ -136,7 +136,7 @@ class Writer:
             self._write(d, np.s_[k, g0:g1], field_values(sim, name))
         e = sim.energies()
         values = {"t": sim.t, "kinetic": e.kinetic, "strain": e.strain,
-                  "hourglass": e.hourglass, "total": e.total}
+                  "hourglass": e.hourglass, "total": e.total, "external": e.external}
         # small per-frame scalars: every rank writes the same value collectively
         self._write(self.time, np.s_[k:k + 1], np.array([sim.t]))
         for key, d in self.energy.items():

@@ -10,6 +10,7 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
+    [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
     [output]      every (steps), fields
 
 Horizon.  A part's horizon is delta = horizon_factor * dx * (1 + HORIZON_TOL)
@@ -31,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from .geometry import SHAPES
-from .loads import BOUNDARIES, INITIAL
+from .loads import BOUNDARIES, INITIAL, LOADS
 from .materials import MATERIALS
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
@@ -143,6 +144,7 @@ class Scene:
     solver: Solver = field(default_factory=Solver)
     initial: tuple = tagged(INITIAL, list, default=())
     boundaries: tuple = tagged(BOUNDARIES, list, default=())
+    loads: tuple = tagged(LOADS, list, default=())
     output: Output = field(default_factory=Output)
 
     def check(self, path):

@@ -37,9 +37,13 @@ from .kernels import integrate
 
 @dataclass
 class Energies:
+    """Global energies (J).  ``total`` is the mechanical energy; ``external`` the
+    work done so far by the loads, so total - external is what the run conserves
+    (or dissipates)."""
     kinetic: float
     strain: float
     hourglass: float
+    external: float = 0.0
 
     @property
     def total(self) -> float:
@@ -84,6 +88,10 @@ class Simulation:
                         if scene.can_fail else None)
         self.mode = self.failure.mode if self.failure else np.zeros(p.n_local, np.uint8)
         self.damp = self.failure.damp if self.failure else np.zeros(0)
+        # time-dependent body forces (none: no arrays, no calls)
+        self.loads = [ld.prepare(scene.parts, p) for ld in scene.loads]
+        self._b_prev = [np.zeros_like(pl.g) for pl in self.loads]
+        self.external_work = 0.0
         self.step_count = 0
         self.t = 0.0
         self.initialize()
@@ -94,6 +102,7 @@ class Simulation:
         self.corr.deform(self.u, self.v)
         self.corr.commit()
         self.compute_forces()
+        self.apply_loads(self.t, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
 
     # ------------------------------------------------------------------ pipeline
@@ -103,6 +112,19 @@ class Simulation:
         self.halo.exchange(self.corr.fd)
         self.corr.gather(self.u, self.v, self.f)
 
+    def apply_loads(self, t: float, dt: float):
+        """Add the loads' body forces at time t to f; accumulate their work over the
+        step just taken, dt * V * (b_old + b_new)/2 . v_{n+1/2} (trapezoidal)."""
+        V = self.points.volume
+        for k, pl in enumerate(self.loads):
+            b = pl.load.value(t) * pl.g
+            self.f[pl.idx] += b
+            if dt:
+                vh = self.v[pl.idx]
+                self.external_work += dt * float(
+                    np.sum(V[pl.idx] * np.einsum("ij,ij->i", 0.5 * (self._b_prev[k] + b), vh)))
+            self._b_prev[k] = b
+
     def update(self, dt: float):
         """Everything between the two half kicks: kinematics, stress, forces."""
         self.halo.exchange(self.u, self.v)
@@ -110,6 +132,8 @@ class Simulation:
         self.corr.rotate(dt)
         self.corr.update_stress(dt, self.mode)
         self.compute_forces()
+        if self.loads:
+            self.apply_loads(self.t + dt, dt)
         self.corr.commit()
 
     def step(self):
@@ -127,7 +151,8 @@ class Simulation:
     def energies(self) -> Energies:
         n = self.points.n_owned
         ke = integrate.kinetic_energy(self.v, self.rho, self.points.volume[:n])
-        local = np.array([ke, self.corr.strain_energy(), self.corr.hourglass_energy(self.u)])
+        local = np.array([ke, self.corr.strain_energy(), self.corr.hourglass_energy(self.u),
+                          self.external_work])
         tot = self.team.sum(local)
         if not np.all(np.isfinite(tot)):
             raise FloatingPointError(
