@@ -1,6 +1,8 @@
 """Command line: ``mpipd run | check | scenes``.
 
     mpirun -n 2 mpipd run SCENE [--set key.path=value ...] [--out DIR] [--overwrite]
+                              [--force] [--stop-after N]
+    mpirun -n 3 mpipd run --restart DIR/checkpoint.h5 [--out DIR]
     mpipd check SCENE [--ranks N] [--set ...]
     mpipd scenes
 
@@ -28,7 +30,13 @@ def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mpipd", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run a scene (under mpirun for several ranks)")
-    r.add_argument("scene")
+    r.add_argument("scene", nargs="?", help="scene file or built-in name (not with --restart)")
+    r.add_argument("--restart", metavar="CHECKPOINT",
+                   help="continue from a checkpoint (any number of ranks)")
+    r.add_argument("--stop-after", type=int, default=None, metavar="STEP",
+                   help="write a checkpoint at this step and stop")
+    r.add_argument("--force", action="store_true",
+                   help="run even if dt exceeds the stable estimate")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, e.g. --set time.steps=100")
     r.add_argument("--out", default=None, help="output directory (default runs/<scene name>)")
@@ -106,6 +114,7 @@ def _bad_input(team, exc) -> int:
 
 
 def _run(args, team) -> int:
+    from . import checkpoint as ck
     from . import scene as sc
     from .decomp import DecompositionError
     from .output import Writer
@@ -114,36 +123,65 @@ def _run(args, team) -> int:
     from .solver import Progress, Simulation
 
     try:
-        scene, text = sc.load(args.scene, args.set)
-        out = Path(args.out) if args.out else Path("runs") / scene.name
+        if args.restart:
+            if args.scene:
+                raise UsageError("give either SCENE or --restart (the scene is in the checkpoint)")
+            text, overrides, _ = ck.read_scene(args.restart)
+            overrides = overrides + list(args.set)
+            scene = sc.parse(text, str(args.restart), overrides)
+            out = Path(args.out) if args.out else Path(args.restart).resolve().parent
+        else:
+            if not args.scene:
+                raise UsageError("run needs a SCENE (or --restart CHECKPOINT)")
+            scene, text = sc.load(args.scene, args.set)
+            overrides = list(args.set)
+            out = Path(args.out) if args.out else Path("runs") / scene.name
         h5 = out / "run.h5"
-        if h5.exists() and not args.overwrite:
+        resume = bool(args.restart) and h5.exists()
+        if h5.exists() and not (args.overwrite or resume):
             raise UsageError(f"{h5} exists (use --overwrite to replace it, or another --out)")
         if out.exists() and not out.is_dir():
             raise UsageError(f"--out {out} exists and is not a directory")
+        dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
+        if scene.time.dt > dt_stable and not args.force:
+            raise UsageError(f"time.dt = {scene.time.dt:.4e} s exceeds the stable estimate "
+                             f"{dt_stable:.4e} s (see `mpipd check`); use --force to run anyway")
         sim = Simulation(scene, team)
-    except (SceneError, DecompositionError, UsageError) as e:
+        if args.restart:
+            ck.restore(sim, args.restart)
+    except (SceneError, DecompositionError, UsageError, ck.CheckpointError) as e:
         return _bad_input(team, e)
-    if args.set:
-        text += "\n# overrides (--set)\n" + "".join(f"# {o}\n" for o in args.set)
     n_steps = scene.time.n_steps
     if team.root:
         out.mkdir(parents=True, exist_ok=True)
-        print(f"mpipd: {scene.name}: {sim.n_global} points, {sim.n_bonds_global} bonds, "
+        what = f"restart at step {sim.step_count}, " if args.restart else ""
+        print(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
               f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}",
               flush=True)
-        dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
         if scene.time.dt > dt_stable:
             print(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
-                  f"{dt_stable:.4e} s (see `mpipd check`); the run may blow up", flush=True)
+                  f"{dt_stable:.4e} s (--force); the run may blow up", flush=True)
         if sim.n_spring_global:
             print(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
                   "(shape tensor not invertible)", flush=True)
     team.barrier()
-    writer = Writer(h5, sim, text, n_steps)
+    shown = text + ("\n# overrides (--set)\n" + "".join(f"# {o}\n" for o in overrides)
+                    if overrides else "")
+    writer = Writer(h5, sim, shown, n_steps, resume=resume)
     progress = None if args.quiet else Progress(team, scene.solver.progress_every)
-    wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress)
+    checkpointer = ck.Checkpointer(sim, out / "checkpoint.h5", text, overrides,
+                                   every=scene.output.checkpoint_every,
+                                   stop_after=args.stop_after)
+    checkpointer.install_signals()
+    wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
+                   checkpointer=checkpointer)
     writer.close()
+    if sim.step_count < n_steps:
+        if team.root:
+            print(f"mpipd: stopped at step {sim.step_count} of {n_steps}; checkpoint "
+                  f"{checkpointer.written}; continue with `mpipd run --restart "
+                  f"{checkpointer.written}`", flush=True)
+        return 0
     n_spring = sim.spring_points()
     failed = sim.failure_counts()
     broken = sim.bonds_broken()

@@ -72,6 +72,14 @@ class Failure:
         self.seconds += time.perf_counter() - t0
         return len(new)
 
+    def refresh_damage(self):
+        """phi and the damped set of every owned point from the bond states (restart)."""
+        p, fam = self.points, self.families
+        pd_damage(np.arange(p.n_owned, dtype=np.int64), fam.offsets, fam.nbr, fam.broken,
+                  p.volume, self.phi)
+        if self.damping > 0:
+            self.damp[:] = np.where(self.phi >= 1.0, self.damping, 0.0)
+
     def counts(self) -> np.ndarray:
         """Owned failed points per mode (index = mode)."""
         return np.bincount(self.mode[: self.points.n_owned], minlength=4)

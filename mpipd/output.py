@@ -76,7 +76,9 @@ def field_values(sim, name: str) -> np.ndarray:
 class Writer:
     """Collective writer of one run file.  All ranks call every method."""
 
-    def __init__(self, path, sim, scene_text: str, n_steps: int):
+    def __init__(self, path, sim, scene_text: str, n_steps: int, resume: bool = False):
+        """Create the run file — or, with ``resume``, reopen it and continue after the
+        frames up to the simulation's current step (restart)."""
         import h5py
         self.path = Path(path)
         self.sim = sim
@@ -86,6 +88,15 @@ class Writer:
         self.n_frames = n_frames(n_steps, self.every)
         self.frame_no = 0
         comm = sim.team.comm
+        if resume:
+            self.f = h5py.File(self.path, "r+", driver="mpio", comm=comm)
+            self.dsets = {name: self.f["fields"][name] for name in self.fields}
+            self.time = self.f["time"]
+            self.energy = {k: self.f["energy"][k] for k in self.f["energy"]}
+            self.frame_no = sim.step_count // self.every + 1
+            if self.dsets and next(iter(self.dsets.values())).shape[0] != self.n_frames:
+                raise ValueError(f"{self.path} was sized for another run length")
+            return
         self.f = h5py.File(self.path, "w", driver="mpio", comm=comm)
         N = sim.n_global
         a = self.f.attrs
@@ -143,6 +154,7 @@ class Writer:
             self._write(d, np.s_[k:k + 1], np.array([values[key]]))
         self.frame_no += 1
         self.f.attrs["frames_written"] = self.frame_no
+        self.f.flush()                  # a crash loses at most the frames since this one
 
     def close(self):
         self.f.attrs["frames_written"] = self.frame_no

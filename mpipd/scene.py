@@ -124,9 +124,11 @@ class Solver:
 class Output:
     every: int = 10
     fields: tuple[str, ...] = ("u", "v")
+    checkpoint_every: int = 0         # steps between checkpoints; 0 = only on signal/stop
 
     def check(self, path):
         positive(self, path, "every")
+        non_negative(self, path, "checkpoint_every")
         for i, f in enumerate(self.fields):
             if f not in OUTPUT_FIELDS:
                 fail(join(join(path, "fields"), i),

@@ -208,19 +208,25 @@ class Simulation:
                 "bytes_per_point": (point + tree) / max(1, self.points.n_local)}
 
     # ------------------------------------------------------------------ time loop
-    def run(self, n_steps: int, writer=None, every: int = 0, progress=None) -> float:
-        """Advance ``n_steps`` steps, writing a frame every ``every`` steps (and the
-        last).  Returns the wall time of the loop (output included)."""
+    def run(self, n_steps: int, writer=None, every: int = 0, progress=None,
+            checkpointer=None) -> float:
+        """Advance to step ``n_steps`` (from the current step: a restart continues),
+        writing a frame every ``every`` steps and at the last step, and
+        checkpointing as ``checkpointer`` says.  Returns the loop's wall time."""
         if writer is not None and self.step_count == 0:
             writer.frame(self)
         t0 = _time.perf_counter()
-        for s in range(n_steps):
+        first = self.step_count
+        while self.step_count < n_steps:
             self.step()
-            last = s == n_steps - 1
+            last = self.step_count == n_steps
             if writer is not None and every and (self.step_count % every == 0 or last):
                 writer.frame(self)
             if progress is not None:
-                progress(self, s + 1, n_steps, _time.perf_counter() - t0)
+                progress(self, self.step_count - first, n_steps - first,
+                         _time.perf_counter() - t0)
+            if checkpointer is not None and not last and checkpointer.after_step():
+                break
         return _time.perf_counter() - t0
 
 

@@ -1,0 +1,74 @@
+"""Checkpoint/restart: stop a fracturing run, continue on the same and on a
+different number of ranks, and get the uninterrupted run's fields bit for bit."""
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+from conftest import run_cli
+
+from mpipd import checkpoint as ck
+from mpipd import scene as sc
+from mpipd.solver import Simulation
+
+ARGS = ["--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=8e-6",
+        "--set", "output.every=40", "--quiet",
+        "--set", 'output.fields=["u","v","damage","failure_mode","jh2_damage","stress"]']
+KEYS = ("fields/u", "fields/v", "fields/damage", "fields/failure_mode", "fields/jh2_damage",
+        "fields/stress", "time")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref") / "run"
+    res = run_cli(["run", "granite_ring", "--out", str(out), *ARGS], ranks=1)
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out / "run.h5", "r") as f:
+        return {k: f[k][...] for k in KEYS} | {"broken": f.attrs["bonds_broken"]}
+
+
+def test_restart_same_and_different_rank_count(tmp_path, reference):
+    a = tmp_path / "a"
+    res = run_cli(["run", "granite_ring", "--out", str(a), "--stop-after", "70", *ARGS], ranks=2)
+    assert res.returncode == 0, res.stderr
+    assert "stopped at step 70" in res.stdout and (a / "checkpoint.h5").exists()
+    shutil.copytree(a, tmp_path / "b")
+    for d, n in ((a, 2), (tmp_path / "b", 3)):
+        res = run_cli(["run", "--restart", str(d / "checkpoint.h5"), "--quiet"], ranks=n)
+        assert res.returncode == 0, res.stdout + res.stderr
+        with h5py.File(d / "run.h5", "r") as f:
+            assert f.attrs["bonds_broken"] == reference["broken"]
+            for k in KEYS:
+                assert np.array_equal(f[k][...], reference[k]), f"{k} differs after restart on {n}"
+
+
+def test_bad_checkpoint_is_a_clear_error(tmp_path):
+    bad = tmp_path / "checkpoint.h5"
+    bad.write_bytes(b"not hdf5")
+    res = run_cli(["run", "--restart", str(bad)])
+    assert res.returncode == 2 and "cannot read checkpoint" in res.stderr
+    res = run_cli(["run", "granite_ring", "--restart", str(bad)])
+    assert res.returncode == 2 and "either SCENE or --restart" in res.stderr
+
+
+def test_signal_flag_checkpoints_and_stops(team, tmp_path):
+    scene, text = sc.load("granite_ring", ["parts.0.dx=0.002"])
+    sim = Simulation(scene, team)
+    cp = ck.Checkpointer(sim, tmp_path / "c.h5", text, poll=5)
+    for _ in range(4):
+        sim.step()
+        assert not cp.after_step()
+    cp.signalled = True                      # what the SIGTERM/SIGUSR1 handler sets
+    sim.step()
+    assert cp.after_step() and (tmp_path / "c.h5").exists()
+    assert ck.read_scene(tmp_path / "c.h5")[2] == 5
+
+
+def test_dt_above_stable_is_refused_unless_forced(tmp_path):
+    out = tmp_path / "o"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), "--set", "time.dt=1e-6"])
+    assert res.returncode == 2 and "--force" in res.stderr and not out.exists()
+    res = run_cli(["run", "elastic_wave", "--out", str(out), "--force", "--quiet",
+                   "--set", "time.dt=1e-6", "--set", "time.t_end=2e-6",
+                   "--set", "parts.0.dx=0.004"])
+    assert res.returncode == 0 and "warning" in res.stdout
