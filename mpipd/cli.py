@@ -117,6 +117,7 @@ def _run(args, team) -> int:
     from . import checkpoint as ck
     from . import scene as sc
     from .decomp import DecompositionError
+    from .geometry import check_parts
     from .output import Writer
     from .report import stable_dt
     from .schema import SceneError
@@ -142,6 +143,7 @@ def _run(args, team) -> int:
             raise UsageError(f"{h5} exists (use --overwrite to replace it, or another --out)")
         if out.exists() and not out.is_dir():
             raise UsageError(f"--out {out} exists and is not a directory")
+        check_parts(scene.parts)             # geometry first: empty, oversized, overlapping
         dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
         if scene.time.dt > dt_stable and not args.force:
             raise UsageError(f"time.dt = {scene.time.dt:.4e} s exceeds the stable estimate "
