@@ -131,6 +131,11 @@ class Checkpointer:
         for sig in (signal.SIGTERM, signal.SIGUSR1):
             signal.signal(sig, handler)
 
+    def write_final(self):
+        """A last checkpoint for inspection (after a failure), beside the regular one."""
+        self.written = write(self.sim, self.path.with_name("checkpoint_failed.h5"),
+                             self.scene_text, self.overrides)
+
     def after_step(self) -> bool:
         """Checkpoint if due; True if the run should stop now."""
         step = self.sim.step_count

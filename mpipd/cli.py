@@ -20,6 +20,7 @@ import sys
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
+EXIT_UNSTABLE = 3
 
 
 class UsageError(Exception):
@@ -121,7 +122,7 @@ def _run(args, team) -> int:
     from .output import Writer
     from .report import stable_dt
     from .schema import SceneError
-    from .solver import Progress, Simulation
+    from .solver import Progress, Simulation, Unstable
 
     try:
         if args.restart:
@@ -156,47 +157,63 @@ def _run(args, team) -> int:
     n_steps = scene.time.n_steps
     if team.root:
         out.mkdir(parents=True, exist_ok=True)
-        what = f"restart at step {sim.step_count}, " if args.restart else ""
-        print(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
-              f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}",
-              flush=True)
-        if scene.time.dt > dt_stable:
-            print(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
-                  f"{dt_stable:.4e} s (--force); the run may blow up", flush=True)
-        if sim.n_spring_global:
-            print(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
-                  "(shape tensor not invertible)", flush=True)
+    log = RunLog(out / "run.log", team)
+    what = f"restart at step {sim.step_count}, " if args.restart else ""
+    log(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
+        f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}")
+    if scene.time.dt > dt_stable:
+        log(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
+            f"{dt_stable:.4e} s (--force); the run may blow up")
+    if sim.n_spring_global:
+        log(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
+            "(shape tensor not invertible)")
     team.barrier()
     shown = text + ("\n# overrides (--set)\n" + "".join(f"# {o}\n" for o in overrides)
                     if overrides else "")
     writer = Writer(h5, sim, shown, n_steps, resume=resume)
-    progress = None if args.quiet else Progress(team, scene.solver.progress_every)
+    progress = None if args.quiet else Progress(team, scene.solver.progress_every, log=log)
     checkpointer = ck.Checkpointer(sim, out / "checkpoint.h5", text, overrides,
                                    every=scene.output.checkpoint_every,
                                    stop_after=args.stop_after)
     checkpointer.install_signals()
-    wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
-                   checkpointer=checkpointer)
+    try:
+        wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
+                       checkpointer=checkpointer)
+    except Unstable as e:
+        writer.close()
+        log(f"mpipd: error: {e}; state saved in {checkpointer.written}", error=True)
+        return EXIT_UNSTABLE
     writer.close()
     if sim.step_count < n_steps:
-        if team.root:
-            print(f"mpipd: stopped at step {sim.step_count} of {n_steps}; checkpoint "
-                  f"{checkpointer.written}; continue with `mpipd run --restart "
-                  f"{checkpointer.written}`", flush=True)
+        log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; checkpoint "
+            f"{checkpointer.written}; continue with `mpipd run --restart {checkpointer.written}`")
         return 0
     n_spring = sim.spring_points()
     failed = sim.failure_counts()
     broken = sim.bonds_broken()
-    if team.root:
-        rate = sim.n_bonds_global * n_steps / max(wall, 1e-12)
-        print(f"mpipd: done in {wall:.2f} s: {rate / 1e6:.2f} M bond-steps/s, "
-              f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}",
-              flush=True)
-        if sim.failure is not None:
-            print(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
-                  f"{failed[3]} tension model; {broken} bonds broken", flush=True)
-        print(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}", flush=True)
+    rate = sim.n_bonds_global * n_steps / max(wall, 1e-12)
+    log(f"mpipd: done in {wall:.2f} s: {rate / 1e6:.2f} M bond-steps/s, "
+        f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}")
+    if sim.failure is not None:
+        log(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
+            f"{failed[3]} tension model; {broken} bonds broken")
+    log(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}")
     return 0
+
+
+class RunLog:
+    """Rank 0 prints each line and appends it to the run's log file."""
+
+    def __init__(self, path, team):
+        self.path = path
+        self.root = team.root
+
+    def __call__(self, msg: str, error: bool = False):
+        if not self.root:
+            return
+        print(msg, file=sys.stderr if error else sys.stdout, flush=True)
+        with open(self.path, "a") as f:
+            f.write(msg + "\n")
 
 
 if __name__ == "__main__":

@@ -35,6 +35,10 @@ from .halo import Halo
 from .kernels import integrate
 
 
+class Unstable(RuntimeError):
+    """Non-finite values appeared; the message names the step, field, gid and position."""
+
+
 @dataclass
 class Energies:
     """Global energies (J).  ``total`` is the mechanical energy; ``external`` the
@@ -155,10 +159,28 @@ class Simulation:
                           self.external_work])
         tot = self.team.sum(local)
         if not np.all(np.isfinite(tot)):
-            raise FloatingPointError(
-                f"non-finite energy at step {self.step_count} (t = {self.t:.4e} s): the run "
-                "went unstable; compare dt with the stable step of `mpipd check`")
+            self.check_finite()
+            raise Unstable(f"non-finite energy at step {self.step_count} (t = {self.t:.4e} s): "
+                           "the run went unstable; compare dt with `mpipd check`")
         return Energies(*map(float, tot))
+
+    def check_finite(self):
+        """Raise :class:`Unstable` on every rank if any owned u, v or stress is NaN/Inf,
+        naming the first bad point (lowest gid) over all ranks."""
+        n = self.points.n_owned
+        bad = None
+        for name, arr in (("u", self.u[:n]), ("v", self.v[:n]), ("stress", self.corr.sigma)):
+            rows = np.flatnonzero(~np.all(np.isfinite(arr.reshape(n, -1)), axis=1))
+            if len(rows):
+                i = rows[0]
+                cand = (int(self.points.gid[i]), name, tuple(self.points.x[i]))
+                bad = cand if bad is None or cand[0] < bad[0] else bad
+        found = [b for b in self.team.gather(bad) if b is not None]
+        if found:
+            gid, name, x = min(found)
+            raise Unstable(f"non-finite {name} at step {self.step_count} (t = {self.t:.4e} s), "
+                           f"first at gid {gid}, x = ({x[0]:.4g}, {x[1]:.4g}, {x[2]:.4g}) m; "
+                           "compare dt with `mpipd check`")
 
     def bonds_broken(self) -> int:
         return self.team.sum(self.failure.bonds_broken) if self.failure else 0
@@ -220,7 +242,15 @@ class Simulation:
         while self.step_count < n_steps:
             self.step()
             last = self.step_count == n_steps
-            if writer is not None and every and (self.step_count % every == 0 or last):
+            frame = writer is not None and every and (self.step_count % every == 0 or last)
+            if frame or self.step_count % FINITE_CHECK_EVERY == 0:
+                try:
+                    self.check_finite()
+                except Unstable:
+                    if checkpointer is not None:
+                        checkpointer.write_final()
+                    raise
+            if frame:
                 writer.frame(self)
             if progress is not None:
                 progress(self, self.step_count - first, n_steps - first,
@@ -230,27 +260,37 @@ class Simulation:
         return _time.perf_counter() - t0
 
 
-class Progress:
-    """One line on rank 0 every ``every`` steps (or about every ``seconds``)."""
+#: steps between NaN/Inf checks of the owned fields (also at every frame)
+FINITE_CHECK_EVERY = 10
 
-    def __init__(self, team, every: int = 0, seconds: float = 2.0, stream=None):
-        import sys
+
+class Progress:
+    """One line on rank 0 every ``every`` steps (or about every ``seconds``): step,
+    simulated time, wall time, ETA, throughput, failed points and energy.  Rank 0
+    decides when a line is due and tells the others, since the line needs global sums."""
+
+    def __init__(self, team, every: int = 0, seconds: float = 2.0, log=None):
         self.team = team
         self.every = every
         self.seconds = seconds
-        self.stream = stream or sys.stdout
+        self.log = log or (lambda msg: print(msg, flush=True))
         self._last = 0.0
 
     def __call__(self, sim, done: int, total: int, wall: float):
         if self.every:
             due = done % self.every == 0 or done == total
         else:
-            due = wall - self._last >= self.seconds or done == total
-        if not due or not self.team.root:
+            due = self.team.bcast(wall - self._last >= self.seconds or done == total)
+        if not due:
             return
         self._last = wall
+        failed = int(sim.failure_counts()[1:].sum()) if sim.failure is not None else 0
+        energy = sim.energies().total
+        if not self.team.root:
+            return
         rate = sim.n_bonds_global * done / max(wall, 1e-12)
         eta = wall / done * (total - done)
-        print(f"step {sim.step_count:>7d}/{total:<7d} t={sim.t:.4e} s  wall={wall:8.1f} s  "
-              f"eta={eta:8.1f} s  {rate / 1e6:8.2f} M bond-steps/s "
-              f"({rate / self.team.size / 1e6:.2f} per rank)", file=self.stream, flush=True)
+        self.log(f"step {sim.step_count:>7d}/{sim.step_count - done + total:<7d} "
+                 f"t={sim.t * 1e6:9.4f} us  wall={wall:8.1f} s  eta={eta:8.1f} s  "
+                 f"{rate / 1e6:8.2f} M bond-steps/s ({rate / self.team.size / 1e6:.2f} per rank)  "
+                 f"failed={failed}  E={energy:.5g} J")

@@ -72,3 +72,17 @@ def test_dt_above_stable_is_refused_unless_forced(tmp_path):
                    "--set", "time.dt=1e-6", "--set", "time.t_end=2e-6",
                    "--set", "parts.0.dx=0.004"])
     assert res.returncode == 0 and "warning" in res.stdout
+
+
+def test_blow_up_is_stopped_with_its_first_bad_point(tmp_path):
+    """dt forced to 3x the stable step: the run stops on all ranks, names the step,
+    field, gid and position, and leaves a checkpoint for inspection."""
+    out = tmp_path / "o"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), "--force", "--quiet",
+                   "--set", "parts.0.dx=0.004", "--set", "time.dt=2.6e-6",
+                   "--set", "time.t_end=1e-3"], ranks=2, timeout=120)
+    assert res.returncode == 3, res.stdout + res.stderr
+    msg = [ln for ln in res.stderr.splitlines() if ln.startswith("mpipd: error")]
+    assert len(msg) == 1 and "non-finite" in msg[0] and "gid" in msg[0] and "x = (" in msg[0]
+    assert (out / "checkpoint_failed.h5").exists()
+    assert "non-finite" in (out / "run.log").read_text()
