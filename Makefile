@@ -22,7 +22,8 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 
 demo: install
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run granite_ring --out runs/demo --overwrite
-	@echo "demo: wrote runs/demo/run.h5 and runs/demo/run.xdmf (open the .xdmf in ParaView)"
+	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --out runs/demo/fracture.png
+	@echo "demo: wrote runs/demo/run.h5, runs/demo/run.xdmf (open in ParaView) and the fracture pattern runs/demo/fracture.png"
 
 test: install
 	$(PY) -m pytest -q -ra tests

@@ -4,6 +4,8 @@ summary      points, frames, time span, energy drift, peak |v| per frame
 wave-speed   arrival speed of a pulse: the peak time of the cross-section mean of
              one velocity component at several stations along an axis, fitted by a
              straight line (parabolic interpolation of each peak between frames)
+fracture     a PNG of the damage phi (or another scalar field) on the z section
+             nearest --z (default: mid-thickness) at a frame (default: the last)
 """
 from __future__ import annotations
 
@@ -67,6 +69,58 @@ def wave_speed(run: Run, comm, axis: str, component: str, stations, tol) -> tupl
     return speed, arrivals
 
 
+def section(run: Run, comm, field: str, frame: int, z: float | None):
+    """x, y and field values of the points on the z level nearest ``z`` — gathered to
+    rank 0 (one section, not the model)."""
+    x = run.geometry("x")
+    zmin = comm.allreduce(x[:, 2].min() if len(x) else np.inf, op=_mpi_op("MIN"))
+    zmax = comm.allreduce(x[:, 2].max() if len(x) else -np.inf, op=_mpi_op("MAX"))
+    target = 0.5 * (zmin + zmax) if z is None else z
+    levels = np.unique(x[:, 2])
+    near = levels[np.argmin(np.abs(levels - target))] if len(levels) else np.inf
+    dist = comm.allreduce(abs(near - target), op=_mpi_op("MIN"))
+    cands = comm.allgather(near if abs(near - target) == dist else np.inf)
+    zlev = min(cands)
+    sel = x[:, 2] == zlev
+    vals = run.field(field, frame)[sel]
+    if vals.ndim > 1:
+        raise ValueError(f"field {field!r} is not a scalar")
+    parts = comm.gather((x[sel, 0], x[sel, 1], vals), root=0)
+    if comm.Get_rank() != 0:
+        return None
+    xs, ys, vs = (np.concatenate([p[k] for p in parts]) for k in range(3))
+    return xs, ys, vs, zlev
+
+
+def _mpi_op(name):
+    from mpi4py import MPI
+    return getattr(MPI, name)
+
+
+def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[str]:
+    k = frame % run.frames
+    sec = section(run, comm, field, k, z)
+    if comm.Get_rank() != 0:
+        return []
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    xs, ys, vs, zlev = sec
+    fig, ax = plt.subplots(figsize=(6, 5.2), dpi=120)
+    size = max(1.0, 2.2e4 / max(len(xs), 1))
+    im = ax.scatter(xs * 1e3, ys * 1e3, c=vs, s=size, marker="s", cmap="inferno",
+                    vmin=0.0, vmax=max(1.0, float(vs.max())) if field == "damage" else None)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(f"{field} at t = {run.time[k] * 1e6:.2f} us, z = {zlev * 1e3:.2f} mm")
+    fig.colorbar(im, ax=ax, shrink=0.85)
+    fig.tight_layout()
+    fig.savefig(out)
+    plt.close(fig)
+    return [f"wrote {out} ({len(xs)} points on the section)"]
+
+
 def main(argv=None) -> int:
     from mpi4py import MPI
     comm = MPI.COMM_WORLD
@@ -81,6 +135,12 @@ def main(argv=None) -> int:
     w.add_argument("--stations", required=True, help="comma-separated positions along the axis (m)")
     w.add_argument("--tol", type=float, default=None,
                    help="half-width of a station (m); default half the lattice spacing")
+    fr = sub.add_parser("fracture")
+    fr.add_argument("run")
+    fr.add_argument("--out", default=None, help="PNG path (default: beside the run file)")
+    fr.add_argument("--field", default="damage")
+    fr.add_argument("--frame", type=int, default=-1)
+    fr.add_argument("--z", type=float, default=None, help="section height (m)")
     args = ap.parse_args(argv)
     try:
         run = Run(args.run, comm)
@@ -91,6 +151,10 @@ def main(argv=None) -> int:
     try:
         if args.cmd == "summary":
             lines = summary(run, comm)
+        elif args.cmd == "fracture":
+            from pathlib import Path
+            out = args.out or str(Path(args.run).with_name(f"{args.field}.png"))
+            lines = fracture_png(run, comm, out, args.field, args.frame, args.z)
         else:
             stations = [float(v) for v in args.stations.split(",")]
             tol = args.tol

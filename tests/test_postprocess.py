@@ -60,3 +60,20 @@ def test_bad_input_is_a_clear_error(run_file):
     assert res.returncode == 2 and "cannot open" in res.stderr
     res = post(2, "wave-speed", str(run_file), "--stations", "0.5")      # beyond the bar
     assert res.returncode == 2 and "no points near station" in res.stderr
+
+
+def test_fracture_png(tmp_path):
+    out = tmp_path / "ring"
+    res = run_cli(["run", "granite_ring", "--out", str(out), "--quiet",
+                   "--set", "parts.0.dx=0.002", "--set", "time.t_end=6e-6"], ranks=2)
+    assert res.returncode == 0, res.stderr
+    import matplotlib.image as mpimg
+    imgs = []
+    for n in (1, 2):
+        png = tmp_path / f"f{n}.png"
+        res = post(n, "fracture", str(out / "run.h5"), "--out", str(png))
+        assert res.returncode == 0 and "wrote" in res.stdout, res.stderr
+        imgs.append(mpimg.imread(png))
+    assert imgs[0].shape[0] > 300 and np.array_equal(imgs[0], imgs[1])
+    res = post(1, "fracture", str(out / "run.h5"), "--field", "u")
+    assert res.returncode == 2 and "not a scalar" in res.stderr
