@@ -153,6 +153,13 @@ class Correspondence:
         return np.stack([T[:, 0, 0], T[:, 1, 1], T[:, 2, 2],
                          T[:, 1, 2], T[:, 0, 2], T[:, 0, 1]], axis=1)
 
+    def cauchy_stress_of(self, i: int) -> np.ndarray:
+        """Rotated Cauchy stress of one owned point, Voigt order."""
+        s = self.sigma[i]
+        S = np.array([[s[0], s[5], s[4]], [s[5], s[1], s[3]], [s[4], s[3], s[2]]])
+        T = self.R[i] @ S @ self.R[i].T
+        return np.array([T[0, 0], T[1, 1], T[2, 2], T[1, 2], T[0, 2], T[0, 1]])
+
     def strain_energy(self) -> float:
         n = self.points.n_owned
         return float(np.dot(self.W, self.points.volume[:n]))

@@ -13,6 +13,7 @@ does not depend on the number of ranks that wrote it::
     /fields/<name>          (n_frames, N[, k])   u, v, stress, strain_energy
     /time                   (n_frames,)
     /energy/{t, kinetic, strain, hourglass, total, external}   (n_frames,)
+    /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
 ``run.xdmf`` beside the file opens the fields in ParaView.
@@ -96,6 +97,8 @@ class Writer:
             self.frame_no = sim.step_count // self.every + 1
             if self.dsets and next(iter(self.dsets.values())).shape[0] != self.n_frames:
                 raise ValueError(f"{self.path} was sized for another run length")
+            if sim.probes is not None:
+                sim.probes.create(self.f, n_steps + 1)
             return
         self.f = h5py.File(self.path, "w", driver="mpio", comm=comm)
         N = sim.n_global
@@ -132,6 +135,8 @@ class Writer:
         eg = self.f.create_group("energy")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8")
                        for k in ("t", "kinetic", "strain", "hourglass", "total", "external")}
+        if sim.probes is not None:
+            sim.probes.create(self.f, n_steps + 1)
 
     @staticmethod
     def _write(dset, sel, data):
@@ -153,10 +158,14 @@ class Writer:
         for key, d in self.energy.items():
             self._write(d, np.s_[k:k + 1], np.array([values[key]]))
         self.frame_no += 1
+        if sim.probes is not None:
+            sim.probes.flush()
         self.f.attrs["frames_written"] = self.frame_no
         self.f.flush()                  # a crash loses at most the frames since this one
 
     def close(self):
+        if self.sim.probes is not None:
+            self.sim.probes.flush()
         self.f.attrs["frames_written"] = self.frame_no
         self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()

@@ -11,6 +11,7 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
+    [[probes]]    name, position, center (radial axis): recorded every step
     [output]      every (steps), fields
 
 Horizon.  A part's horizon is delta = horizon_factor * dx * (1 + HORIZON_TOL)
@@ -34,6 +35,7 @@ from typing import Any
 from .geometry import SHAPES
 from .loads import BOUNDARIES, INITIAL, LOADS
 from .materials import MATERIALS
+from .probes import Probe
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3
@@ -147,6 +149,7 @@ class Scene:
     initial: tuple = tagged(INITIAL, list, default=())
     boundaries: tuple = tagged(BOUNDARIES, list, default=())
     loads: tuple = tagged(LOADS, list, default=())
+    probes: tuple[Probe, ...] = ()
     output: Output = field(default_factory=Output)
 
     def check(self, path):
@@ -162,6 +165,11 @@ class Scene:
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
             names.add(p.name)
+        seen = set()
+        for i, pr in enumerate(self.probes):
+            if pr.name in seen or not pr.name.isidentifier():
+                fail(f"probes[{i}].name", f"probe names must be unique identifiers ({pr.name!r})")
+            seen.add(pr.name)
         needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
                  "plastic": self.has_model("jh2") or self.has_model("j2")}
         for i, f in enumerate(self.output.fields):

@@ -32,6 +32,7 @@ from .failure import Failure
 from .families import build_families
 from .geometry import LayerTable
 from .halo import Halo
+from .probes import Probes
 from .kernels import integrate
 
 
@@ -99,6 +100,7 @@ class Simulation:
         self.step_count = 0
         self.t = 0.0
         self.initialize()
+        self.probes = Probes(self, scene.probes) if scene.probes else None
 
     def initialize(self):
         """F from the current (initial) displacement and the forces it gives."""
@@ -235,12 +237,16 @@ class Simulation:
         """Advance to step ``n_steps`` (from the current step: a restart continues),
         writing a frame every ``every`` steps and at the last step, and
         checkpointing as ``checkpointer`` says.  Returns the loop's wall time."""
+        if self.probes is not None and self.step_count == 0:
+            self.probes.sample()
         if writer is not None and self.step_count == 0:
             writer.frame(self)
         t0 = _time.perf_counter()
         first = self.step_count
         while self.step_count < n_steps:
             self.step()
+            if self.probes is not None:
+                self.probes.sample()
             last = self.step_count == n_steps
             frame = writer is not None and every and (self.step_count % every == 0 or last)
             if frame or self.step_count % FINITE_CHECK_EVERY == 0:

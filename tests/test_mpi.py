@@ -88,12 +88,22 @@ def fracture_runs(tmp_path_factory):
 def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
     """Same failed set, same broken bonds, bit-identical fields (3 ranks: multi-hop halo)."""
     keys = ("fields/u", "fields/v", "fields/damage", "fields/failure_mode", "fields/jh2_damage",
-            "fields/pressure")
+            "fields/pressure") + tuple(f"probes/{p}/{q}" for p in ("near", "far")
+                                       for q in ("t", "sigma_rr", "v_r", "p", "s", "strength"))
     with h5py.File(fracture_runs[1], "r") as f1:
         ref = {k: f1[k][...] for k in keys}
         broken = f1.attrs["bonds_broken"]
         modes = f1.attrs["failed_points_by_mode"]
     assert broken > 1000 and modes[1] > 0 and modes[3] > 0     # crushing and tension cracks
+    # probes: one row per step, and v_r agrees with the v field at a frame (step 40)
+    with h5py.File(fracture_runs[1], "r") as f1:
+        g = f1["probes/near"]
+        assert len(g["t"]) == 161 and not np.isnan(g["v_r"][...]).any()
+        gid = g.attrs["gid"]
+        x = f1["geometry/x"][gid]
+        v = f1["fields/v"][1, gid]
+        want = (v[0] * x[0] + v[1] * x[1]) / np.hypot(x[0], x[1])
+        assert abs(g["v_r"][40] - want) <= 1e-12 * abs(want)
     for n in (2, 3):
         with h5py.File(fracture_runs[n], "r") as f:
             assert f.attrs["bonds_broken"] == broken

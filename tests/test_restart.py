@@ -15,7 +15,7 @@ ARGS = ["--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=8e-6",
         "--set", "output.every=40", "--quiet",
         "--set", 'output.fields=["u","v","damage","failure_mode","jh2_damage","stress"]']
 KEYS = ("fields/u", "fields/v", "fields/damage", "fields/failure_mode", "fields/jh2_damage",
-        "fields/stress", "time")
+        "fields/stress", "time", "probes/near/sigma_rr", "probes/far/strength", "probes/far/t")
 
 
 @pytest.fixture(scope="module")
