@@ -57,7 +57,35 @@ def jh2_block(n: int, steps: int) -> dict:
     return d
 
 
-CASES = {"elastic": elastic_block, "jh2": jh2_block}
+def blast_slice(n: int, steps: int) -> dict:
+    """A single-hole slice: explosive (r < 3.2 mm), copper tube (0.6 mm), JH2 granite
+    with the tension model out to n/3 mm (20 mm for n = 60), 10 mm thick, dx 0.5 mm
+    throughout; detonated from z = 0 (the gas is ~2.6% of the points)."""
+    R = n / 3 * 1e-3
+    z = [0.0, 0.010]
+    return {
+        "scene": {"name": "bench_blast"},
+        "time": {"dt": 1.5e-8, "steps": steps},
+        "materials": {
+            "explosive": {"model": "jwl", "damping": 1e4, "interacts_with": ["copper"]},
+            "copper": {"model": "j2"},
+            "granite": {"model": "jh2",
+                        "tension": {"sigma_st": -6.9e6, "c1": 0.33, "rate0": 0.4}}},
+        "parts": [
+            {"name": "charge", "material": "explosive", "dx": 5e-4,
+             "shape": {"kind": "cylinder", "center": [0, 0], "radius": 0.0032, "z": z}},
+            {"name": "tube", "material": "copper", "dx": 5e-4,
+             "shape": {"kind": "annulus", "center": [0, 0], "inner_radius": 0.0032,
+                       "radius": 0.0038, "z": z}},
+            {"name": "rock", "material": "granite", "dx": 5e-4,
+             "shape": {"kind": "annulus", "center": [0, 0], "inner_radius": 0.0038,
+                       "radius": R, "z": z}}],
+        "solver": {"hourglass": 0.01, "contact": True, "damping": 2e5,
+                   "viscosity": {"cq": 8.0, "cl": 0.1}},
+    }
+
+
+CASES = {"elastic": elastic_block, "jh2": jh2_block, "blast": blast_slice}
 
 
 def main():
@@ -77,17 +105,23 @@ def main():
     team.barrier()
     failed0 = int(sim.failure_counts()[1:].sum())
     book0 = sim.failure.seconds if sim.failure else 0.0
+    if sim.gas is not None:
+        sim.gas.search_seconds = 0.0
     t0 = time.perf_counter()
     for _ in range(args.steps):
         sim.step()
     wall = team.max(time.perf_counter() - t0)
     extra = ""
+    if sim.gas is not None:
+        share = team.max(sim.gas.search_seconds) / wall
+        extra += (f" gas_points_pct={100.0 * team.sum(len(sim.gas.gas_idx)) / sim.n_global:.2f}"
+                  f" gas_research_share={share:.3f}")
     if sim.failure is not None:
         book = team.max(sim.failure.seconds - book0)
         failed = int(sim.failure_counts()[1:].sum())
         per100 = (failed - failed0) / sim.n_global * 100.0 / args.steps * 100.0
-        extra = (f" failed_pct_per_100_steps={per100:.3f} failed_total={failed}"
-                 f" bonds_broken={sim.bonds_broken()} breakage_share={book / wall:.3f}")
+        extra += (f" failed_pct_per_100_steps={per100:.3f} failed_total={failed}"
+                  f" bonds_broken={sim.bonds_broken()} breakage_share={book / wall:.3f}")
     mem = sim.memory()
     bpb = team.max(mem["bytes_per_bond"])
     bpp = team.max(mem["bytes_per_point"])

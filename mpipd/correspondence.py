@@ -48,7 +48,7 @@ class MaterialGroup:
 
 class Correspondence:
     def __init__(self, points, families, materials: dict, material_names, hourglass: float,
-                 contact: bool = False, viscosity=None):
+                 contact: bool = False, viscosity=None, tl=None):
         n, nl = points.n_owned, points.n_local
         self.points = points
         self.families = families
@@ -88,6 +88,8 @@ class Correspondence:
         bulk = np.array([m.bulk_modulus for m in mats])[points.material]
         self.cbb = 18.0 * bulk / (math.pi * points.horizon ** 4)
         self.n_spring = 0
+        # points outside the total-Lagrangian model (the gas): fallback code 3, never counted
+        self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
 
     # ---------------------------------------------------------------- steps
     def rebuild_shape(self, which: np.ndarray | None = None) -> int:
@@ -98,8 +100,13 @@ class Correspondence:
             which = np.arange(p.n_owned, dtype=np.int64)
         nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
                            self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
-        self.n_spring = int(np.count_nonzero(self.spring))
+        self.spring[self.not_tl] = 3
+        self.n_spring = self.count_spring()
         return self.n_spring
+
+    def count_spring(self) -> int:
+        """Owned total-Lagrangian points on the bond-spring fallback."""
+        return int(np.count_nonzero((self.spring == 1) | (self.spring == 2)))
 
     def deform(self, u, v):
         p, fam = self.points, self.families
@@ -129,7 +136,7 @@ class Correspondence:
             viscosity_data(self.dil, self.gamma, self.J, self.trK, self.spring,
                            self.visc_l, self.visc_q, self.fd)
         if n_bad:
-            self.n_spring = int(np.count_nonzero(self.spring))
+            self.n_spring = self.count_spring()
         return n_bad
 
     def gather(self, u, v, f):

@@ -34,6 +34,7 @@ class Slabs:
     table: LayerTable
     bounds: np.ndarray          # rank r owns layers [bounds[r], bounds[r+1])
     halo: float
+    gas_parts: frozenset = frozenset()   # parts replicated on every rank (explosive gas)
 
     @property
     def n_ranks(self) -> int:
@@ -57,9 +58,22 @@ class Slabs:
                 int(np.searchsorted(z, z1 + self.halo, side="right")))
 
     def ghost_layers(self, r: int) -> np.ndarray:
+        """Static ghosts (within the halo), then every other gas layer (by owner, gid)."""
+        return np.concatenate((self.static_ghost_layers(r), self.gas_layers_beyond(r)))
+
+    def static_ghost_layers(self, r: int) -> np.ndarray:
         lo, hi = self.reach(r)
         a, b = self.owned(r)
         return np.concatenate((np.arange(lo, a), np.arange(b, hi)))
+
+    def gas_layers_beyond(self, r: int) -> np.ndarray:
+        """Gas layers outside rank r's reach: gas moves far, so every rank holds all of it."""
+        if not self.gas_parts:
+            return np.empty(0, np.int64)
+        lo, hi = self.reach(r)
+        L = np.arange(len(self.table.z))
+        gas = np.isin(self.table.part, list(self.gas_parts))
+        return L[gas & ((L < lo) | (L >= hi))]
 
     def points_of(self, r: int) -> tuple[int, int]:
         """(owned, ghost) point counts of rank r."""
@@ -82,24 +96,35 @@ class Slabs:
         # local start of every ghost layer
         gstart = n_owned + np.concatenate(([0], np.cumsum(counts[ghosts])[:-1])).astype(np.int64)
         owner = self.owner_of_layer(ghosts)
+        n_static = len(self.static_ghost_layers(r))
         recv = []
-        for q in np.unique(owner):
-            sel = np.nonzero(owner == q)[0]
-            start = int(gstart[sel[0]])
-            recv.append((int(q), start, start + int(counts[ghosts[sel]].sum())))
+        for kind in (slice(0, n_static), slice(n_static, len(ghosts))):
+            own = owner[kind]
+            base = np.arange(len(ghosts))[kind]
+            for q in np.unique(own):
+                sel = base[own == q]
+                start = int(gstart[sel[0]])
+                recv.append((int(q), start, start + int(counts[ghosts[sel]].sum())))
+        # receives come as one contiguous range per (peer, kind): static first, then gas
+        recv.sort(key=lambda e: (e[0], e[1]))
         ostart = np.concatenate(([0], np.cumsum(counts[a:b]))).astype(np.int64)
         send = []
         for q in range(self.n_ranks):
             if q == r:
                 continue
             lo, hi = self.reach(q)
-            lo, hi = max(lo, a), min(hi, b)
-            if hi > lo:
-                send.append((q, int(ostart[lo - a]), int(ostart[hi - a])))
+            slo, shi = max(lo, a), min(hi, b)
+            if shi > slo:
+                send.append((q, int(ostart[slo - a]), int(ostart[shi - a])))
+            beyond = self.gas_layers_beyond(q)
+            mine = beyond[(beyond >= a) & (beyond < b)]
+            if len(mine):
+                idx = np.concatenate([np.arange(ostart[L - a], ostart[L - a + 1]) for L in mine])
+                send.append((q, idx.astype(np.int64)))
         return recv, send
 
 
-def decompose(table: LayerTable, n_ranks: int, halo: float) -> Slabs:
+def decompose(table: LayerTable, n_ranks: int, halo: float, gas_parts=()) -> Slabs:
     """Split the layers into ``n_ranks`` slabs of whole z levels, balanced by points."""
     z = table.z
     # candidate cut positions: layer indices where z changes
@@ -121,7 +146,8 @@ def decompose(table: LayerTable, n_ranks: int, halo: float) -> Slabs:
         k = int(np.argmin(np.abs(cum[cand] - target)))
         bounds.append(int(cand[k]))
     bounds.append(len(z))
-    return Slabs(table=table, bounds=np.asarray(bounds, dtype=np.int64), halo=float(halo))
+    return Slabs(table=table, bounds=np.asarray(bounds, dtype=np.int64), halo=float(halo),
+                 gas_parts=frozenset(gas_parts))
 
 
 @dataclass

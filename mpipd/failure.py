@@ -30,7 +30,7 @@ MODE_NAMES = {0: "intact", 1: "JH2 plastic (D >= 1)", 2: "JH2 tensile (p* < -T*)
 
 
 class Failure:
-    def __init__(self, points, families, halo, corr, damping: float):
+    def __init__(self, points, families, halo, corr, damping: float, damp, tl):
         self.points = points
         self.families = families
         self.halo = halo
@@ -41,13 +41,13 @@ class Failure:
         self.phi = np.zeros(n)
         self.touched = np.zeros(n, dtype=np.uint8)
         self.damping = damping
-        self.damp = np.zeros(n) if damping > 0 else np.zeros(0)
+        self.damp = damp                        # the simulation's damping array (or empty)
+        self.tl = tl[:n]                        # only total-Lagrangian points have damage
         self.tree = cKDTree(points.x)
         self.reach = float(points.horizon.max()) if nl else 0.0
         self.bonds_broken = 0
         self.seconds = 0.0                      # wall time spent here (bookkeeping share)
-        pd_damage(np.arange(n, dtype=np.int64), families.offsets, families.nbr,
-                  families.broken, points.volume, self.phi)
+        self.refresh_damage()
 
     def update(self) -> int:
         """Exchange failure flags and break bonds.  Returns the newly failed local points."""
@@ -73,12 +73,12 @@ class Failure:
         return len(new)
 
     def refresh_damage(self):
-        """phi and the damped set of every owned point from the bond states (restart)."""
+        """phi and the damped set of every owned TL point from the bond states."""
         p, fam = self.points, self.families
-        pd_damage(np.arange(p.n_owned, dtype=np.int64), fam.offsets, fam.nbr, fam.broken,
-                  p.volume, self.phi)
+        rows = np.flatnonzero(self.tl).astype(np.int64)
+        pd_damage(rows, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
         if self.damping > 0:
-            self.damp[:] = np.where(self.phi >= 1.0, self.damping, 0.0)
+            self.damp[rows] = np.where(self.phi[rows] >= 1.0, self.damping, 0.0)
 
     def counts(self) -> np.ndarray:
         """Owned failed points per mode (index = mode)."""

@@ -71,11 +71,12 @@ def _csr_by_row(i, j, gid, n_rows):
 
 
 def build_families(x: np.ndarray, gid: np.ndarray, horizon: np.ndarray, n_owned: int,
-                   chunk: int = 16384) -> Families:
+                   chunk: int = 16384, tl=None) -> Families:
     """Families of the first ``n_owned`` points among all ``len(x)`` local points.
 
     Owned points are processed in chunks, so the pair temporaries stay at
-    ``chunk`` families whatever the model size."""
+    ``chunk`` families whatever the model size.  ``tl`` (bool per local point,
+    default all) marks total-Lagrangian points; others (the gas) get no bonds."""
     tree = cKDTree(x)
     counts, nbrs = [], []
     for s in range(0, n_owned, chunk):
@@ -85,6 +86,8 @@ def build_families(x: np.ndarray, gid: np.ndarray, horizon: np.ndarray, n_owned:
         i = m["i"]
         j = m["j"]
         keep = (m["v"] < np.maximum(horizon[i + s], horizon[j])) & (i + s != j)
+        if tl is not None:
+            keep &= tl[i + s] & tl[j]
         c, nb = _csr_by_row(i[keep], j[keep], gid, e - s)
         counts.append(c)
         nbrs.append(nb)

@@ -17,12 +17,20 @@ import numpy as np
 
 class Halo:
     def __init__(self, comm, recv, send, n_owned: int, n_local: int):
+        """``recv``: (peer, start, stop) ranges; ``send``: (peer, start, stop) ranges
+        or (peer, index array) lists (the replicated gas), in the order the peer
+        posts its receives from this rank."""
         self.comm = comm
         self.recv = [(q, a, b) for q, a, b in recv if b > a]
-        self.send = [(q, a, b) for q, a, b in send if b > a]
+        self.send = []
+        for e in send:
+            if len(e) == 3 and e[2] > e[1]:
+                self.send.append((e[0], slice(e[1], e[2]), e[2] - e[1]))
+            elif len(e) == 2 and len(e[1]):
+                self.send.append((e[0], np.asarray(e[1]), len(e[1])))
         self.n_owned = n_owned
         self.n_local = n_local
-        self.peers = sorted({q for q, _, _ in self.recv} | {q for q, _, _ in self.send})
+        self.peers = sorted({e[0] for e in self.recv} | {e[0] for e in self.send})
         self._verify()
 
     def _verify(self):
@@ -30,12 +38,12 @@ class Halo:
         rank = self.comm.Get_rank()
         size = self.comm.Get_size()
         expect = [0] * size
-        for q, a, b in self.send:
-            expect[q] = b - a
+        for q, _, n in self.send:
+            expect[q] += n
         got = self.comm.alltoall(expect)
         want = [0] * size
         for q, a, b in self.recv:
-            want[q] = b - a
+            want[q] += b - a
         if got != want:
             raise RuntimeError(f"rank {rank}: halo plan mismatch: peers send {got}, "
                                f"this rank expects {want}")
@@ -49,9 +57,12 @@ class Halo:
                 raise ValueError("halo: arrays must be C-contiguous with n_local rows")
             for q, a, b in self.recv:
                 reqs.append(self.comm.Irecv(arr[a:b], source=q, tag=t))
+        keep = []                                   # packed buffers live until Waitall
         for t, arr in enumerate(arrays):
-            for q, a, b in self.send:
-                reqs.append(self.comm.Isend(arr[a:b], dest=q, tag=t))
+            for q, sel, _ in self.send:
+                buf = arr[sel] if isinstance(sel, slice) else np.ascontiguousarray(arr[sel])
+                keep.append(buf)
+                reqs.append(self.comm.Isend(buf, dest=q, tag=t))
         MPI.Request.Waitall(reqs)
 
     @property

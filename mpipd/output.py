@@ -12,7 +12,7 @@ does not depend on the number of ranks that wrote it::
     /geometry/part          (N,)  part index (attrs: names)
     /fields/<name>          (n_frames, N[, k])   u, v, stress, strain_energy
     /time                   (n_frames,)
-    /energy/{t, kinetic, strain, hourglass, total, external}   (n_frames,)
+    /energy/{t, kinetic, strain, hourglass, gas, total, external}   (n_frames,)
     /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
@@ -64,7 +64,7 @@ FIELD_VALUES = {
     "damage": lambda sim: sim.failure.phi,
     "failure_mode": lambda sim: sim.failure.mode[:sim.points.n_owned].astype(np.float64),
     "jh2_damage": _state("D"),
-    "pressure": _state("pressure"),
+    "pressure": lambda sim: _state("pressure")(sim) + (sim.gas.pressure() if sim.gas else 0.0),
     "plastic_strain": _state("eps_p"),
     "strain_rate": _state("strain_rate"),
 }
@@ -134,7 +134,8 @@ class Writer:
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8")
         eg = self.f.create_group("energy")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8")
-                       for k in ("t", "kinetic", "strain", "hourglass", "total", "external")}
+                       for k in ("t", "kinetic", "strain", "hourglass", "gas", "total",
+                                 "external")}
         if sim.probes is not None:
             sim.probes.create(self.f, n_steps + 1)
 
@@ -152,7 +153,8 @@ class Writer:
             self._write(d, np.s_[k, g0:g1], field_values(sim, name))
         e = sim.energies()
         values = {"t": sim.t, "kinetic": e.kinetic, "strain": e.strain,
-                  "hourglass": e.hourglass, "total": e.total, "external": e.external}
+                  "hourglass": e.hourglass, "gas": e.gas, "total": e.total,
+                  "external": e.external}
         # small per-frame scalars: every rank writes the same value collectively
         self._write(self.time, np.s_[k:k + 1], np.array([sim.t]))
         for key, d in self.energy.items():

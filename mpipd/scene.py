@@ -45,7 +45,7 @@ OUTPUT_FIELDS = {
     "u": (3, None), "v": (3, None), "stress": (6, None), "strain_energy": (1, None),
     "damage": (1, "failure"),            # PD damage phi (Eq. 39)
     "failure_mode": (1, "failure"),      # 0 intact, 1 JH2 D >= 1, 2 JH2 p* < -T*, 3 tension model
-    "jh2_damage": (1, "jh2"), "pressure": (1, "jh2"), "plastic_strain": (1, "plastic"),
+    "jh2_damage": (1, "jh2"), "pressure": (1, "pressure"), "plastic_strain": (1, "plastic"),
     "strain_rate": (1, "jh2"),
 }
 
@@ -165,18 +165,27 @@ class Scene:
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
             names.add(p.name)
+        gas = [m for m, mat in self.materials.items() if getattr(mat, "is_gas", False)]
+        if len(gas) > 1:
+            fail("materials", f"one explosive (jwl) material at most (got {', '.join(gas)})")
+        for m in gas:
+            for a in self.materials[m].interacts_with:
+                if a not in self.materials or a == m:
+                    fail(f"materials.{m}.interacts_with", f"no other material {a!r}")
         seen = set()
         for i, pr in enumerate(self.probes):
             if pr.name in seen or not pr.name.isidentifier():
                 fail(f"probes[{i}].name", f"probe names must be unique identifiers ({pr.name!r})")
             seen.add(pr.name)
         needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
-                 "plastic": self.has_model("jh2") or self.has_model("j2")}
+                 "plastic": self.has_model("jh2") or self.has_model("j2"),
+                 "pressure": self.has_model("jh2") or self.has_model("jwl")}
         for i, f in enumerate(self.output.fields):
             need = OUTPUT_FIELDS[f][1]
             if need is not None and not needs[need]:
                 what = {"failure": "a material that can fail (jh2, or a tension model)",
-                        "jh2": "a jh2 material", "plastic": "a jh2 or j2 material"}[need]
+                    "jh2": "a jh2 material", "plastic": "a jh2 or j2 material",
+                    "pressure": "a jh2 or jwl material"}[need]
                 fail(f"output.fields[{i}]", f"{f!r} needs {what}")
 
     @property

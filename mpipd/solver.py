@@ -31,6 +31,7 @@ from .decomp import decompose, halo_width, local_points
 from .failure import Failure
 from .families import build_families
 from .geometry import LayerTable
+from .gas import Gas
 from .halo import Halo
 from .probes import Probes
 from .kernels import integrate
@@ -49,10 +50,11 @@ class Energies:
     strain: float
     hourglass: float
     external: float = 0.0
+    gas: float = 0.0
 
     @property
     def total(self) -> float:
-        return self.kinetic + self.strain + self.hourglass
+        return self.kinetic + self.strain + self.hourglass + self.gas
 
 
 class Simulation:
@@ -61,13 +63,17 @@ class Simulation:
         self.team = team
         self.dt = scene.time.dt
         table = LayerTable.from_parts(scene.parts, scene.material_ids)
-        self.slabs = decompose(table, team.size, halo_width(scene))
+        gas_parts = [k for k, q in enumerate(scene.parts)
+                     if getattr(scene.materials[q.material], "is_gas", False)]
+        self.slabs = decompose(table, team.size, halo_width(scene), gas_parts)
         self.n_global = table.n_points
         self.gid_range = self.slabs.gid_range(team.rank)
         p = self.points = local_points(scene, self.slabs, team.rank)
         recv, send = self.slabs.plan(team.rank)
         self.halo = Halo(team.comm, recv, send, p.n_owned, p.n_local)
-        self.families = build_families(p.x, p.gid, p.horizon, p.n_owned)
+        self.tl = ~np.isin(p.part, gas_parts)           # total-Lagrangian points (not gas)
+        self.families = build_families(p.x, p.gid, p.horizon, p.n_owned,
+                                       tl=self.tl if gas_parts else None)
         self.n_bonds_global = team.sum(self.families.n_bonds)
 
         n = p.n_owned
@@ -86,13 +92,19 @@ class Simulation:
 
         sv = scene.solver
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
-                                   contact=sv.contact, viscosity=sv.viscosity)
+                                   contact=sv.contact, viscosity=sv.viscosity, tl=self.tl)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
+        # damping (Eq. 41 for phi = 1, and the gas's own), only if some is asked for
+        needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
+        self.damp = np.zeros(n) if needs_damp else np.zeros(0)
         # failure and bond breakage exist only if some material can fail
-        self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping)
-                        if scene.can_fail else None)
+        self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping, self.damp,
+                                self.tl) if scene.can_fail else None)
         self.mode = self.failure.mode if self.failure else np.zeros(p.n_local, np.uint8)
-        self.damp = self.failure.damp if self.failure else np.zeros(0)
+        # the explosive gas exists only if the scene has one
+        self.gas = Gas(self) if gas_parts else None
+        if self.gas is not None:
+            self.damp[self.gas.gas_idx] = self.gas.mat.damping
         # time-dependent body forces (none: no arrays, no calls)
         self.loads = [ld.prepare(scene.parts, p) for ld in scene.loads]
         self._b_prev = [np.zeros_like(pl.g) for pl in self.loads]
@@ -115,8 +127,13 @@ class Simulation:
     def compute_forces(self):
         """Force data of owned points -> halo -> gathered internal force density."""
         self.corr.force_data()
-        self.halo.exchange(self.corr.fd)
+        if self.gas is not None:
+            self.halo.exchange(self.corr.fd, self.gas.gd)
+        else:
+            self.halo.exchange(self.corr.fd)
         self.corr.gather(self.u, self.v, self.f)
+        if self.gas is not None:
+            self.gas.gather(self.u, self.f)
 
     def apply_loads(self, t: float, dt: float):
         """Add the loads' body forces at time t to f; accumulate their work over the
@@ -134,6 +151,8 @@ class Simulation:
     def update(self, dt: float):
         """Everything between the two half kicks: kinematics, stress, forces."""
         self.halo.exchange(self.u, self.v)
+        if self.gas is not None:                    # Eqs. 45–48, detonation
+            self.gas.update(self.u, self.v, dt, self.t + dt)
         self.corr.deform(self.u, self.v)
         self.corr.rotate(dt)
         self.corr.update_stress(dt, self.mode)
@@ -158,7 +177,7 @@ class Simulation:
         n = self.points.n_owned
         ke = integrate.kinetic_energy(self.v, self.rho, self.points.volume[:n])
         local = np.array([ke, self.corr.strain_energy(), self.corr.hourglass_energy(self.u),
-                          self.external_work])
+                          self.external_work, self.gas.energy() if self.gas else 0.0])
         tot = self.team.sum(local)
         if not np.all(np.isfinite(tot)):
             self.check_finite()

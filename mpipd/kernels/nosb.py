@@ -113,7 +113,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
     N = np.empty((3, 3))
     Nd = np.empty((3, 3))
     for i in range(n):
-        if spring[i] == 1:                     # K not invertible: no F at all
+        if spring[i] % 2 == 1:                 # K not invertible (1) or not TL (3): no F
             for r in range(3):
                 for c in range(3):
                     F[i, r, c] = 1.0 if r == c else 0.0
@@ -194,7 +194,7 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
     P = np.empty((3, 3))
     n_bad = 0
     for i in range(n_owned):
-        if spring[i] != 1:
+        if spring[i] % 2 == 0:
             J = det3(F[i])
             if J > 0.0 and math.isfinite(J):
                 spring[i] = 0

@@ -45,7 +45,7 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J):
             for c in range(3):
                 Fm[r, c] = 0.5 * (F_old[i, r, c] + F_new[i, r, c])
         Jm = det3(Fm)
-        if spring[i] == 1 or not (Jm > 0.0 and math.isfinite(Jm)):
+        if spring[i] % 2 == 1 or not (Jm > 0.0 and math.isfinite(Jm)):
             for c in range(6):                  # no continuum kinematics this step
                 d[i, c] = 0.0
             J[i] = 1.0

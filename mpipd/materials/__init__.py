@@ -31,4 +31,4 @@ from ..schema import Registry
 
 MATERIALS = Registry("material model", "model")
 
-from . import elastic, j2, jh2  # noqa: E402,F401  (registers)
+from . import elastic, j2, jh2, jwl  # noqa: E402,F401  (registers)
