@@ -3,8 +3,8 @@
 A checkpoint holds everything the next step needs that cannot be recomputed
 from it: u, v, a, the unrotated stress, R, V, strain energy, the fallback
 flags, failure modes, every material history array, the broken bonds (as
-(gid_i, gid_j) pairs), the loads' work, the step and the time, and the scene
-text.  Shape tensors, F, damage phi, the damped set and the force data are
+(gid_i, gid_j) pairs), the gas's volume, pressure and energy, the loads' work,
+the step and the time, and the scene text.  Shape tensors, F, damage phi, the damped set and the force data are
 rebuilt from it deterministically.
 
 Because every per-point dataset is indexed by gid and broken bonds by gid
@@ -42,6 +42,13 @@ def _per_point(sim) -> dict:
             full = np.zeros((n,) + arr.shape[1:], arr.dtype)
             full[g.idx] = arr
             out[f"state{gi}/{key}"] = full
+    if sim.gas is not None:                       # volume, pressure, energy of the gas
+        gas = sim.gas
+        out["gas_V"] = gas.gd[:n, 6]
+        out["gas_p"] = gas.gd[:n, 7]
+        e = np.zeros(n)
+        e[gas.gas_idx] = gas.e
+        out["gas_e"] = e
     return out
 
 
@@ -182,6 +189,11 @@ def restore(sim, path) -> None:
         key = gid[rows] * sim.n_global + gid[fam.nbr]
         want = np.sort(mine[:, 0] * sim.n_global + mine[:, 1])
         fam.broken[:] = np.isin(key, want).astype(np.uint8)
+    if sim.gas is not None:
+        gas = sim.gas
+        gas.gd[:n, 6], gas.gd[:n, 7] = data["gas_V"], data["gas_p"]
+        gas.e[:] = data["gas_e"][gas.gas_idx]
+        gas.V_ratio[gas.gas_idx] = gas.gd[gas.gas_idx, 6] / gas.V0
     sim.step_count, sim.t = step, t
     sim.external_work = work if team.root else 0.0
     # rebuild what follows from the state
