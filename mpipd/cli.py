@@ -197,6 +197,17 @@ def _run(args, team) -> int:
     if sim.failure is not None:
         log(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
             f"{failed[3]} tension model; {broken} bonds broken")
+    if sim.gas is not None:
+        peak = team.max(sim.gas.peak_pressure)
+        m = sim.gas.mat
+        cj = m.chapman_jouguet()
+        log(f"mpipd: peak gas pressure {peak / 1e9:.3f} GPa (pressure_factor {m.pressure_factor:g}; "
+            f"Table 2 implies p_CJ = {cj['p'] / 1e9:.2f} GPa, D_CJ = {cj['D']:.0f} m/s; "
+            f"the paper reports up to 1.8 GPa)")
+    if sim.probes is not None:
+        for name, (srr, vr, pmax) in sim.probes.peaks().items():
+            log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "
+                f"{vr:.2f} m/s, peak pressure {pmax / 1e6:.1f} MPa")
     log(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}")
     return 0
 

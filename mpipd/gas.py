@@ -54,6 +54,7 @@ class Gas:
         self.nbr = np.zeros(0, np.int32)
         self.search_seconds = 0.0
         self.n_singular = 0
+        self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
 
     def search(self, u):
         """Current-configuration families, each sorted by neighbour gid."""
@@ -84,6 +85,8 @@ class Gas:
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas)
         self.V_ratio[self.gas_idx] = self.gd[self.gas_idx, 6] / self.V0
+        if len(self.gas_idx):
+            self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, 7].max()))
 
     def gather(self, u, f):
         p = self.points

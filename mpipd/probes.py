@@ -51,12 +51,24 @@ class Probes:
             if len(local):
                 self.mine.append((k, int(local[0])))
         self.rows = {k: [] for k, _ in self.mine}
+        self.history = {k: [] for k, _ in self.mine}   # (t, sigma_rr, v_r, p) for the peaks
         self.start = {k: 0 for k, _ in self.mine}       # step of the first buffered row
         self._jh2 = {}
         for g in sim.corr.groups:
             if g.material.registry_name == "jh2":
                 for pos, i in enumerate(g.idx):
                     self._jh2[int(i)] = (g, pos)
+
+    def peaks(self) -> dict:
+        """name -> (most compressive sigma_rr, largest |v_r|, largest p) so far, gathered
+        from the owner ranks (every rank gets the same dict)."""
+        local = {self.probes[k].name: (min(r[1] for r in rows), max(abs(r[2]) for r in rows),
+                                       max(r[3] for r in rows))
+                 for k, rows in self.history.items() if rows}
+        out = {}
+        for part in self.sim.team.gather(local):
+            out.update(part)
+        return out
 
     def sample(self):
         sim = self.sim
@@ -73,7 +85,9 @@ class Probes:
             seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
             if not self.rows[k]:
                 self.start[k] = sim.step_count
-            self.rows[k].append((sim.t, srr, vr, p, seq, self._strength(i)))
+            row = (sim.t, srr, vr, p, seq, self._strength(i))
+            self.rows[k].append(row)
+            self.history[k].append(row[:4])
 
     def _strength(self, i) -> float:
         if i not in self._jh2 or self.sim.mode[i] != 0:

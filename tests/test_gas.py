@@ -123,3 +123,21 @@ def test_restart_through_the_detonation(tmp_path, det_runs):
             assert np.array_equal(f[k][...], f1[k][...]), k
         # a global sum: equal up to the order of the reduction
         np.testing.assert_allclose(f["energy/gas"][...], f1["energy/gas"][...], rtol=1e-12)
+
+
+def test_blast_slice_reports_peak_pressures(tmp_path):
+    out = tmp_path / "bs"
+    res = run_cli(["run", "blast_slice", "--out", str(out), "--quiet",
+                   "--set", "parts.2.shape.radius=0.009", "--set", "time.t_end=1.5e-6",
+                   "--set", "parts.0.shape.z=[0.0, 0.004]", "--set", "parts.1.shape.z=[0.0, 0.004]",
+                   "--set", "parts.2.shape.z=[0.0, 0.004]", "--set", "probes.0.position=[0.00405, 0.0, 0.002]",
+                   "--set", "probes.1.position=[0.0075, 0.0, 0.002]",
+                   "--set", "probes.2.position=[0.0085, 0.0, 0.002]"], ranks=2)
+    assert res.returncode == 0, res.stdout + res.stderr
+    line = [ln for ln in res.stdout.splitlines() if "peak gas pressure" in ln]
+    assert line
+    peak = float(line[0].split("peak gas pressure")[1].split()[0])
+    assert 3.0 < peak < 20.0                       # GPa: between p(1, e0)/2 and above p_CJ
+    wall = [ln for ln in res.stdout.splitlines() if "probe wall" in ln]
+    assert wall and float(wall[0].split("peak radial stress")[1].split()[0]) < -10.0
+    assert "peak gas pressure" in (out / "run.log").read_text()
