@@ -32,6 +32,15 @@ MIN_NEIGHBOURS = 6
 RCOND_M = 1e-3
 
 
+@numba.njit(cache=True, inline="always")
+def current_bond(y, i, j):
+    """Deformed bond Y = y_j - y_i and |Y|."""
+    y0 = y[j, 0] - y[i, 0]
+    y1 = y[j, 1] - y[i, 1]
+    y2 = y[j, 2] - y[i, 2]
+    return y0, y1, y2, math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+
+
 @numba.njit(cache=True)
 def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
                V0, e, A, B, R1, R2, w, kfac, is_gas):
@@ -54,10 +63,7 @@ def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_l
         nb = 0
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
-            y0 = y[j, 0] - y[i, 0]
-            y1 = y[j, 1] - y[i, 1]
-            y2 = y[j, 2] - y[i, 2]
-            ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            y0, y1, y2, ly = current_bond(y, i, j)
             if ly >= di:
                 continue
             wgt = (di - ly) * (di - ly) * (V_snap[j] if is_gas[j] else V_ref[j])
@@ -133,10 +139,7 @@ def gas_gather(rows, y, V_ref, V0_ratio, gd, delta, offsets, nbr, is_gas, f):
         fx = fy = fz = 0.0
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
-            y0 = y[j, 0] - y[i, 0]
-            y1 = y[j, 1] - y[i, 1]
-            y2 = y[j, 2] - y[i, 2]
-            ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            y0, y1, y2, ly = current_bond(y, i, j)
             tx = ty = tz = 0.0
             if ly < di:
                 w = (di - ly) * (di - ly)
