@@ -29,11 +29,23 @@ FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touche
 DAMPING_OWNED = 8
 VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 24
 JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
+GAS_LOCAL, GAS_OWNED = 74, 24   # gas force data (8), flags, gas horizon; UL offsets, V ratio, damping
+BYTES_PER_GAS_POINT = 48        # index, V0, e, lighting time, eligible/row lists
+BYTES_PER_UL_BOND = 4           # current-configuration family entry (int32)
+
+
+def is_gas_part(scene, part) -> bool:
+    return bool(getattr(scene.materials[part.material], "is_gas", False))
 
 
 def memory_model(scene) -> tuple[int, int]:
-    """(bytes per local point, extra bytes per owned point) for the scene's features."""
+    """(bytes per local point, bytes per owned point) for the scene's features; a
+    scene with an explosive adds BYTES_PER_GAS_POINT per gas point on every rank
+    (plus its current-configuration families)."""
     local, owned = BYTES_PER_LOCAL_POINT, BYTES_PER_OWNED_POINT
+    if any(is_gas_part(scene, q) for q in scene.parts):
+        local += GAS_LOCAL
+        owned += GAS_OWNED
     if scene.can_fail:
         local += FAILURE_LOCAL
         owned += FAILURE_OWNED + (DAMPING_OWNED if scene.solver.damping > 0 else 0)
@@ -72,9 +84,12 @@ def check_report(scene, ranks: int) -> str:
     total_bonds = 0
     family = {}
     dt_limits = []
+    gas_points = 0
     for k, p in enumerate(scene.parts):
         npts = int(table.count[table.part == k].sum())
-        fam = len(bulk_family(p.dx, p.horizon))
+        fam = 0 if is_gas_part(scene, p) else len(bulk_family(p.dx, p.horizon))
+        if is_gas_part(scene, p):
+            gas_points += npts
         family[k] = fam
         total_bonds += npts * fam
         mat = scene.materials[p.material]
@@ -82,7 +97,9 @@ def check_report(scene, ranks: int) -> str:
         dt_limits.append(min(dt_sa, dt_cfl))
         out.append(f"  part {p.name!r}: {p.shape.registry_name}, material {p.material!r} "
                    f"({mat.registry_name}), dx = {p.dx:.4g} m, horizon = {p.horizon:.4g} m "
-                   f"({p.horizon_factor:g} dx), {npts} points, {fam} bonds per bulk point")
+                   f"({p.horizon_factor:g} dx), {npts} points, "
+                   + ("updated-Lagrangian gas: families re-found every step, held on every rank"
+                      if is_gas_part(scene, p) else f"{fam} bonds per bulk point"))
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
     for name, mat in scene.materials.items():
@@ -106,7 +123,8 @@ def check_report(scene, ranks: int) -> str:
         a, b = slabs.owned(r)
         layers = np.arange(a, b)
         bonds = int(sum(table.count[L] * family[int(table.part[L])] for L in layers))
-        mem = (per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * bonds)
+        mem = (per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * bonds
+               + BYTES_PER_GAS_POINT * gas_points)
         thick = z1 - z0 + float(scene.max_dx)
         recv, _ = slabs.plan(r)
         peers = len(recv)

@@ -3,13 +3,14 @@ counted by walking every array the simulation holds."""
 import pytest
 
 from mpipd import scene as sc
-from mpipd.report import BYTES_PER_BOND, memory_model
+from mpipd.report import BYTES_PER_BOND, BYTES_PER_GAS_POINT, memory_model
 from mpipd.solver import Simulation
 
 
 @pytest.mark.parametrize("name,over", [
     ("elastic_wave", ["parts.0.dx=0.004"]),
     ("granite_ring", ["parts.0.dx=0.002"]),
+    ("detonation_tube", ["parts.2.shape.radius=0.005"]),
 ])
 def test_memory_model_matches_allocation(team, name, over):
     scene, _ = sc.load(name, over)
@@ -18,6 +19,8 @@ def test_memory_model_matches_allocation(team, name, over):
     p = sim.points
     local, owned = memory_model(scene)
     model = local * p.n_local + owned * p.n_owned
+    if sim.gas is not None:
+        model += BYTES_PER_GAS_POINT * len(sim.gas.gas_idx)
     actual = m["point_bytes"] + m["tree_bytes"]
     assert abs(actual - model) <= 0.01 * model + 4096, (actual, model)
     assert m["bytes_per_bond"] == BYTES_PER_BOND <= 24
