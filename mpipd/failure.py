@@ -25,10 +25,6 @@ from scipy.spatial import cKDTree
 
 from .kernels.breakage import break_bonds, pairs_from_lists, pd_damage
 
-MODE_NAMES = {0: "intact", 1: "JH2 plastic (D >= 1)", 2: "JH2 tensile (p* < -T*)",
-              3: "tension model (Eqs. 37-38)"}
-
-
 class Failure:
     def __init__(self, points, families, halo, corr, damping: float, damp, tl):
         self.points = points

@@ -35,13 +35,6 @@ class Families:
     def n_bonds(self) -> int:
         return len(self.nbr)
 
-    @property
-    def bytes_per_bond(self) -> float:
-        return (self.nbr.itemsize + self.broken.itemsize)
-
-    def sizes(self) -> np.ndarray:
-        return np.diff(self.offsets)
-
 
 @numba.njit(cache=True)
 def _csr_by_row(i, j, gid, n_rows):

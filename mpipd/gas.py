@@ -55,12 +55,12 @@ class Gas:
         self.search_seconds = 0.0
         self.n_singular = 0
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
+        self.y = None                            # current positions of the last update
 
-    def search(self, u):
-        """Current-configuration families, each sorted by neighbour gid."""
+    def search(self, y):
+        """Current-configuration families (positions y), each sorted by neighbour gid."""
         t0 = time.perf_counter()
         p = self.points
-        y = p.x + u
         el = self.eligible
         n = p.n_owned
         if len(self.rows) and len(el):
@@ -77,9 +77,9 @@ class Gas:
 
     def update(self, u, v, dt: float, t: float):
         """Families, then volume, energy, pressure and force data of the owned gas."""
-        self.search(u)
         p, m = self.points, self.mat
-        y = p.x + u
+        y = self.y = p.x + u                    # current positions, kept for gather()
+        self.search(y)
         self.n_singular = gas_update(
             self.gas_idx, y, v, p.volume, self.gd[:, 6].copy(), self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
@@ -89,8 +89,10 @@ class Gas:
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, 7].max()))
 
     def gather(self, u, f):
+        """UL forces into f; u must be the displacement update() last saw."""
         p = self.points
-        gas_gather(self.rows, p.x + u, p.volume, self.V_ratio, self.gd, p.horizon,
+        y = self.y if self.y is not None else p.x + u
+        gas_gather(self.rows, y, p.volume, self.V_ratio, self.gd, p.horizon,
                    self.offsets, self.nbr, self.is_gas, f)
 
     def energy(self) -> float:

@@ -64,7 +64,3 @@ class Halo:
                 keep.append(buf)
                 reqs.append(self.comm.Isend(buf, dest=q, tag=t))
         MPI.Request.Waitall(reqs)
-
-    @property
-    def n_ghost(self) -> int:
-        return self.n_local - self.n_owned

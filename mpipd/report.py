@@ -31,7 +31,6 @@ VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 24
 JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
 GAS_LOCAL, GAS_OWNED = 74, 24   # gas force data (8), flags, gas horizon; UL offsets, V ratio, damping
 BYTES_PER_GAS_POINT = 48        # index, V0, e, lighting time, eligible/row lists
-BYTES_PER_UL_BOND = 4           # current-configuration family entry (int32)
 
 
 def is_gas_part(scene, part) -> bool:

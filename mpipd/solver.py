@@ -116,6 +116,8 @@ class Simulation:
 
     def initialize(self):
         """F from the current (initial) displacement and the forces it gives."""
+        if getattr(self, "gas", None) is not None:
+            self.gas.y = None                   # positions come from u, not a past update
         self.halo.exchange(self.u, self.v)
         self.corr.deform(self.u, self.v)
         self.corr.commit()

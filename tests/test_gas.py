@@ -100,7 +100,7 @@ def test_gas_has_no_bonds_and_does_not_touch_rock(team):
     gas = sim.gas.is_gas.astype(bool)
     rows = np.repeat(np.arange(p.n_owned), np.diff(fam.offsets))
     assert not gas[rows].any() and not gas[fam.nbr].any()        # no TL bond touches gas
-    sim.gas.search(sim.u)
+    sim.gas.search(sim.points.x + sim.u)
     g = sim.gas
     ul_rows = np.repeat(np.arange(p.n_owned), np.diff(g.offsets))
     names = list(scene.materials)

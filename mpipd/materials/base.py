@@ -24,12 +24,6 @@ class Material:
         return math.sqrt((self.bulk_modulus + 4.0 * self.shear_modulus / 3.0) / self.density)
 
     @property
-    def bar_wave_speed(self) -> float:
-        """Thin-bar wave speed sqrt(E / rho), E = 9KG / (3K + G)."""
-        K, G = self.bulk_modulus, self.shear_modulus
-        return math.sqrt(9.0 * K * G / (3.0 * K + G) / self.density)
-
-    @property
     def hourglass_modulus(self) -> float:
         """Modulus that gives the hourglass penalty (Eq. 15) its units: G."""
         return self.shear_modulus
