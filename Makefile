@@ -21,8 +21,8 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 	touch $@
 
 demo: install
-	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run granite_ring --out runs/demo --overwrite
-	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --out runs/demo/fracture.png
+	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/demo --overwrite
+	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
 	@echo "demo: wrote runs/demo/run.h5, runs/demo/run.xdmf (open in ParaView) and the fracture pattern runs/demo/fracture.png"
 
 test: install
@@ -33,3 +33,6 @@ bench: install
 
 clean:
 	rm -rf runs .pytest_cache
+
+# further targets (verify, jobs-test, ...) live in mk/*.mk, one file a topic
+-include mk/*.mk

@@ -5,6 +5,7 @@
     mpirun -n 3 mpipd run --restart DIR/checkpoint.h5 [--out DIR]
     mpipd check SCENE [--ranks N] [--set ...]
     mpipd scenes
+    mpipd cases SCENE           (then run SCENE:CASE)
 
 SCENE is a TOML file or the name of a built-in scene.  Bad input (scene
 errors, an existing output file, a decomposition that cannot work) prints one
@@ -48,6 +49,8 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--ranks", type=int, default=1)
     c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     sub.add_parser("scenes", help="list the built-in scenes")
+    k = sub.add_parser("cases", help="list the named cases of a built-in scene (run SCENE:CASE)")
+    k.add_argument("scene")
     return ap
 
 
@@ -55,6 +58,8 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.cmd == "scenes":
         return cmd_scenes()
+    if args.cmd == "cases":
+        return _guard_serial(cmd_cases, args)
     if args.cmd == "check":
         return _guard_serial(cmd_check, args)
     return cmd_run(args)
@@ -84,6 +89,16 @@ def cmd_scenes() -> int:
         except Exception as e:   # a broken built-in is still listed
             desc = f"(invalid: {e})"
         print(f"{name:24s} {desc}")
+    return 0
+
+
+def cmd_cases(args) -> int:
+    """One line a case: ``SCENE:CASE``, its study and what it changes."""
+    from . import scene as sc
+    if args.scene not in sc.builtin_scenes():
+        raise UsageError(f"no built-in scene {args.scene!r}")
+    for name, case in sc.cases(args.scene).items():
+        print(f"{args.scene}:{name:8s} {case.study:15s} {case.description}")
     return 0
 
 
@@ -135,8 +150,8 @@ def _run(args, team) -> int:
         else:
             if not args.scene:
                 raise UsageError("run needs a SCENE (or --restart CHECKPOINT)")
-            scene, text = sc.load(args.scene, args.set)
-            overrides = list(args.set)
+            source, overrides = sc.expand_case(args.scene, args.set)
+            scene, text = sc.load(source, overrides)
             out = Path(args.out) if args.out else Path("runs") / scene.name
         h5 = out / "run.h5"
         resume = bool(args.restart) and h5.exists()

@@ -229,3 +229,36 @@ def fill_layers(parts, table: LayerTable, layers: np.ndarray):
     if not xs:
         return np.empty((0, 3)), np.empty(0, np.int32), np.empty(0, np.int64)
     return np.concatenate(xs), np.concatenate(ps), np.concatenate(gs)
+
+
+def _sphere_directions(n: int) -> np.ndarray:
+    """n nearly uniform unit vectors (Fibonacci sphere)."""
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + 5 ** 0.5) * k
+    s = np.sqrt(1.0 - z * z)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+
+
+def balls_inside(parts, x: np.ndarray, radius: np.ndarray, n_dir: int = 96,
+                 shells=(0.25, 0.5, 0.75, 1.0)) -> np.ndarray:
+    """True where the ball of ``radius`` around ``x`` lies inside the union of
+    ``parts`` (a point set at the centre, on shells of the given fractions of
+    the radius, n_dir directions each, must all lie in some part).  The parts'
+    shared faces count as inside: a sample on a face between two parts is
+    tested with a margin of -1e-9 dx."""
+    inside = np.ones(len(x), dtype=bool)
+    if not len(x):
+        return inside
+    d = _sphere_directions(n_dir)
+    tol = 1e-9 * min(p.dx for p in parts)
+    for f in shells:
+        for u in d:
+            y = x + (f * radius)[:, None] * u
+            ok = np.zeros(len(x), dtype=bool)
+            for p in parts:
+                z0, z1 = p.shape.z_range
+                ok |= ((y[:, 2] > z0 - tol) & (y[:, 2] < z1 + tol)
+                       & p.shape.contains_xy(y[:, 0], y[:, 1], -tol))
+            inside &= ok
+    return inside

@@ -33,6 +33,7 @@ from .families import build_families
 from .geometry import LayerTable
 from .gas import Gas
 from .halo import Halo
+from .interface import InterfaceCorrection, needed as interface_needed
 from .probes import Probes
 from .kernels import integrate
 
@@ -94,6 +95,11 @@ class Simulation:
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
                                    contact=sv.contact, viscosity=sv.viscosity, tl=self.tl)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
+        # the ghost-force correction exists only where dx or the horizon changes
+        tl_parts = [q for k, q in enumerate(scene.parts) if k not in gas_parts]
+        self.interface = (InterfaceCorrection(p, self.families, self.halo, self.corr, self.tl,
+                                              tl_parts)
+                          if interface_needed(scene, tl_parts) else None)
         # damping (Eq. 41 for phi = 1, and the gas's own), only if some is asked for
         needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
         self.damp = np.zeros(n) if needs_damp else np.zeros(0)
@@ -134,6 +140,8 @@ class Simulation:
         else:
             self.halo.exchange(self.corr.fd)
         self.corr.gather(self.u, self.v, self.f)
+        if self.interface is not None:
+            self.interface.apply(self.corr.fd, self.corr.F, self.f)
         if self.gas is not None:
             self.gas.gather(self.u, self.f)
 
@@ -170,7 +178,8 @@ class Simulation:
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
         if self.failure is not None:                # paper §2.7 steps 11–12
             self.corr.check_tension(self.mode)
-            self.failure.update()
+            if self.failure.update() and self.interface is not None:
+                self.interface.retire(self.mode)
         self.step_count += 1
         self.t = self.step_count * dt
 

@@ -68,3 +68,41 @@ def test_bad_load_in_a_scene_is_a_clear_error(tmp_path):
     res = run_cli(["check", "granite_ring", "--set",
                    'loads=[{kind="borehole_pressure", center=[0,0], radius=0.0032, p0=1e9}]'])
     assert res.returncode == 2 and "loads[0]" in res.stderr and "either" in res.stderr
+
+
+def test_radial_velocity_equals_the_impulse_matched_pressure(team):
+    """An initial radial velocity v0 in a shell of width w at a free borehole wall
+    launches (1-D theory) the same outgoing wave as a wall pressure
+    p = rho c_p v0 / 2 held for 2 w / c_p: half the shell's velocity runs out at
+    once, the other half reflects off the free wall and follows.  The two loads'
+    peak radial stresses 6.5 mm out must agree within a few per cent."""
+    rho, c = 2660.0, math.sqrt((21.9e9 + 4 * 25.7e9 / 3) / 2660.0)
+    v0, w = 20.0, 2.0e-3
+    p, T = rho * c * v0 / 2, 2 * w / c
+
+    def peak(**extra):
+        shape = {"kind": "annulus", "center": [0, 0], "inner_radius": R, "radius": 0.032,
+                 "z": [0, H]}
+        d = scene_dict(shape, dx=1e-3, dt=5e-8)
+        d.update(extra)
+        sim = Simulation(make_scene(d), team)
+        n = sim.points.n_owned
+        x = sim.points.x[:n]
+        r = np.hypot(x[:, 0], x[:, 1])
+        er = x[:, :2] / r[:, None]
+        sel = (np.abs(r - R - 6.5e-3) < 0.5e-3) & (np.abs(x[:, 2] - H / 2) < 0.6e-3)
+        pk = 0.0
+        for _ in range(110):
+            sim.step()
+            s = sim.corr.cauchy_stress()[sel]
+            e = er[sel]
+            srr = s[:, 0] * e[:, 0] ** 2 + s[:, 1] * e[:, 1] ** 2 + 2 * s[:, 5] * e[:, 0] * e[:, 1]
+            pk = min(pk, srr.mean())
+        return -pk
+
+    by_velocity = peak(initial=[{"kind": "radial_velocity", "center": [0, 0], "r_inner": 0.0,
+                                 "r_outer": R + w, "speed": v0}])
+    by_pressure = peak(loads=[{"kind": "borehole_pressure", "center": [0, 0], "radius": R,
+                               "times": [0, T, T + 1e-9, 1.0], "pressures": [p, p, 0, 0]}])
+    assert by_velocity > 0.3 * p                    # a real wave arrived
+    assert by_velocity == pytest.approx(by_pressure, rel=0.07)

@@ -6,6 +6,9 @@
   in P, K^-1 or the gather (a uniform-stress patch test cannot).
 * Newton's third law: sum_i f_i V_i = 0 for any u and stress, also across parts
   with different lattice spacings and horizons (dual horizons).
+
+These check the dual-horizon assembly alone; the interface correction, which
+is neither, has its own tests (test_interface.py).
 """
 import numpy as np
 from conftest import granite, make_scene, scene_dict
@@ -20,6 +23,7 @@ def two_parts(hourglass):
               "shape": {"kind": "box", "lo": [0.006, 0, 0], "hi": [0.009, 0.006, 0.006]}}]
     d = scene_dict(None, parts=parts, hourglass=hourglass)
     d["materials"] = {"a": granite(), "b": granite(shear_modulus=40e9, density=8000.0)}
+    d["solver"]["interface_correction"] = False     # the dual-horizon assembly itself
     return make_scene(d)
 
 

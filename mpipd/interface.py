@@ -1,0 +1,98 @@
+"""Ghost-force correction where the resolution changes (dual horizons).
+
+Families are the union of each point's horizon and the points whose horizon
+reaches it, and the pair force is the dual-horizon one (Ren et al. 2016,
+2017; :mod:`mpipd.kernels.nosb`), so momentum is conserved.  Dual horizons
+alone do not pass the patch test, though: under a uniform first Piola stress
+P the force density on point i is
+
+    f_i = P g_i,   g_i = sum_j (omega_i K_i^-1 + omega_j K_j^-1) xi_ij V_j,
+
+and g_i, zero by symmetry inside a uniform lattice, is of order 1/dx within
+two horizons of a change of spacing or horizon (a coarse/fine interface, the
+zones of a graded part).  That is a ghost force: a uniform strain across the
+interface is not in equilibrium.
+
+The correction (this module) subtracts P_i g_i at every point where g_i is
+not zero *and* whose ball of radius twice its reach lies inside the
+total-Lagrangian body — there, and only there, the uniform-stress force is
+pure artefact.  Near a free surface (and at the copper wall facing the gas)
+g_i also carries the surface's traction term, which must stay, so those
+points are left alone.  At a corrected point the force becomes
+
+    f_i = sum_j omega_j V_j (P_j - P_i) K_j^-1 xi_ij   (+ hourglass, contact, viscosity)
+
+(i's own terms cancel exactly),
+
+which is zero for uniform P and reproduces div P for a linear P.  It is not
+the gradient of an energy, and it does not conserve momentum exactly: the
+energy and momentum error it makes are measured in the tests and the README.
+
+g_i is computed once from the reference configuration (it is geometric).
+A point that loses a bond, or whose family holds a failed point, has a
+different geometry from then on: its correction is switched off for good
+(decided from bond states and the exchanged failure flags, so the same on
+any number of ranks and after a restart).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .geometry import balls_inside
+from .kernels import interface as kern
+
+#: |g_i| dx_i above this is a ghost force (round-off in a uniform lattice is ~1e-14)
+G_TOL = 1e-9
+
+
+def needed(scene, tl_parts) -> bool:
+    """A correction exists only if the total-Lagrangian parts differ in dx or horizon."""
+    return (scene.solver.interface_correction
+            and len({(p.dx, p.horizon) for p in tl_parts}) > 1)
+
+
+class InterfaceCorrection:
+    def __init__(self, points, families, halo, corr, tl, tl_parts):
+        p, fam = points, families
+        n = p.n_owned
+        # K^-1 and a no-K flag for every local point (ghosts from their owners)
+        kinv = np.zeros((p.n_local, 10))
+        kinv[:n, :9] = corr.Kinv.reshape(n, 9)
+        kinv[:n, 9] = (corr.spring != 0).astype(float)
+        kinv[n:, 9] = 1.0
+        halo.exchange(kinv)
+        cand = np.flatnonzero(tl[:n] & (corr.spring == 0)).astype(np.int64)
+        g = np.zeros((len(cand), 3))
+        kern.interface_vectors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
+                               kinv, cand, g)
+        sel = np.linalg.norm(g, axis=1) * p.dx[cand] > G_TOL
+        cand, g = cand[sel], g[sel]
+        reach = self._reach(p.horizon, fam, cand)
+        inside = balls_inside(tl_parts, p.x[cand], 2.0 * reach)
+        self.idx = cand[inside]
+        self.n_surface = int(np.count_nonzero(~inside))     # affected, but near a free surface
+        K = np.linalg.inv(corr.Kinv[self.idx])
+        self.q = np.ascontiguousarray(np.einsum("nij,nj->ni", K, g[inside]))
+        self.g = np.ascontiguousarray(g[inside])
+        self.active = np.ones(len(self.idx), dtype=np.uint8)
+        self.families = fam
+
+    @staticmethod
+    def _reach(horizon, fam, idx) -> np.ndarray:
+        """Farthest interaction of each point: its own horizon or a neighbour's."""
+        out = np.empty(len(idx))
+        kern.family_reach(horizon, fam.offsets, fam.nbr, idx, out)
+        return out
+
+    def apply(self, fd, F, f):
+        """f_i -= P_i g_i at the active corrected points."""
+        kern.subtract_ghost_force(fd, F, self.idx, self.q, self.active, f)
+
+    def retire(self, mode) -> int:
+        """Switch off the correction where bonds broke or a family member failed."""
+        fam = self.families
+        return kern.retire(self.idx, self.active, fam.offsets, fam.nbr, fam.broken, mode)
+
+    @property
+    def n_active(self) -> int:
+        return int(np.count_nonzero(self.active))

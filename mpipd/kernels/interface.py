@@ -1,0 +1,100 @@
+"""Kernels of the resolution-interface correction (see :mod:`mpipd.interface`).
+
+Under a uniform first Piola stress P the gathered force density (Eq. 1 with
+dual horizons) on point i is P g_i with the purely geometric vector
+
+    g_i = sum_j (omega_i K_i^-1 + omega_j K_j^-1) xi_ij V_j ,
+
+which vanishes by symmetry inside a uniform lattice but not where horizons
+and spacings change.  The correction subtracts P_i g_i = A_i q_i at the chosen
+points, with A_i = P_i K_i^-1 = B_i + h_i F_i (the force data) and q_i = K_i g_i.
+"""
+import math
+
+import numba
+import numpy as np
+
+from .nosb import influence
+
+
+@numba.njit(cache=True)
+def interface_vectors(x, vol, horizon, offsets, nbr, broken, kinv, points, g):
+    """g_i (1/m) of the owned points in ``points``.  ``kinv`` (n_local, 10) holds
+    K^-1 row-major and, in column 9, 1.0 for a point without one (bond-spring
+    fallback or not total-Lagrangian): such neighbours contribute nothing."""
+    for p in range(points.shape[0]):
+        i = points[p]
+        g0 = g1 = g2 = 0.0
+        di = horizon[i]
+        own = kinv[i, 9] == 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            if broken[b]:
+                continue
+            j = nbr[b]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            vj = vol[j]
+            wi = influence(di, r) * vj if own else 0.0
+            if wi > 0.0:
+                g0 += wi * (kinv[i, 0] * e0 + kinv[i, 1] * e1 + kinv[i, 2] * e2)
+                g1 += wi * (kinv[i, 3] * e0 + kinv[i, 4] * e1 + kinv[i, 5] * e2)
+                g2 += wi * (kinv[i, 6] * e0 + kinv[i, 7] * e1 + kinv[i, 8] * e2)
+            wj = influence(horizon[j], r) * vj
+            if wj > 0.0 and kinv[j, 9] == 0.0:
+                g0 += wj * (kinv[j, 0] * e0 + kinv[j, 1] * e1 + kinv[j, 2] * e2)
+                g1 += wj * (kinv[j, 3] * e0 + kinv[j, 4] * e1 + kinv[j, 5] * e2)
+                g2 += wj * (kinv[j, 6] * e0 + kinv[j, 7] * e1 + kinv[j, 8] * e2)
+        g[p, 0] = g0
+        g[p, 1] = g1
+        g[p, 2] = g2
+
+
+@numba.njit(cache=True)
+def subtract_ghost_force(fd, F, idx, q, active, f):
+    """f_i -= A_i q_i with A_i = B_i + h_i F_i, at the active points ``idx``."""
+    for p in range(idx.shape[0]):
+        if not active[p]:
+            continue
+        i = idx[p]
+        if fd[i, 10] != 0.0:                  # bond-spring fallback this step: no P
+            continue
+        h = fd[i, 9]
+        for r in range(3):
+            acc = 0.0
+            for c in range(3):
+                acc += (fd[i, 3 * r + c] + h * F[i, r, c]) * q[p, c]
+            f[i, r] -= acc
+
+
+@numba.njit(cache=True)
+def retire(idx, active, offsets, nbr, broken, mode):
+    """Switch the correction off for good at points that lost a bond or whose
+    family holds a failed point (their geometry is no longer the reference one).
+    Returns how many were switched off."""
+    n = 0
+    for p in range(idx.shape[0]):
+        if not active[p]:
+            continue
+        i = idx[p]
+        hit = mode[i] != 0
+        b = offsets[i]
+        while not hit and b < offsets[i + 1]:
+            hit = broken[b] != 0 or mode[nbr[b]] != 0
+            b += 1
+        if hit:
+            active[p] = 0
+            n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def family_reach(horizon, offsets, nbr, idx, out):
+    """out[p] = the largest horizon among point idx[p] and its family."""
+    for p in range(idx.shape[0]):
+        i = idx[p]
+        m = horizon[i]
+        for b in range(offsets[i], offsets[i + 1]):
+            m = max(m, horizon[nbr[b]])
+        out[p] = m
