@@ -205,5 +205,7 @@ def restore(sim, path) -> None:
         sim.halo.exchange(fl.mode)
         fl.done[:] = fl.mode != 0
         fl.refresh_damage()
+        if sim.interface is not None:       # retired where bonds broke or families failed
+            sim.interface.retire(sim.mode)
     sim.initialize()
     sim.a[:] = data["a"]
