@@ -171,6 +171,8 @@ class Writer:
         self.f.attrs["frames_written"] = self.frame_no
         self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()
+        if self.sim.gas is not None:    # every step's peak, not just the frames' (since start/restart)
+            self.f.attrs["peak_gas_pressure"] = self.sim.team.max(self.sim.gas.peak_pressure)
         self.f.close()
         if self.sim.team.root:
             write_xdmf(self.path, self.sim.n_global, self.fields, self.frame_no,

@@ -1,4 +1,4 @@
-"""``mpirun -n N python -m postprocess {summary | wave-speed} RUN.h5 [options]``
+"""``mpirun -n N python -m postprocess {summary | wave-speed | fracture | report | compare} RUN.h5``
 
 summary      points, frames, time span, energy drift, peak |v| per frame
 wave-speed   arrival speed of a pulse: the peak time of the cross-section mean of
@@ -6,6 +6,12 @@ wave-speed   arrival speed of a pulse: the peak time of the cross-section mean o
              straight line (parabolic interpolation of each peak between frames)
 fracture     a PNG of the damage phi (or another scalar field) on the z section
              nearest --z (default: mid-thickness) at a frame (default: the last)
+report       the paper's figures (Figs. 7, 9, 11-13, 15-18, 20) of one run and a
+             validation report: report.md and report.json in --out (postprocess.report)
+compare      several runs side by side: compare.md/.json and the fracture patterns,
+             rock energy and peak radial stress of all runs in one figure each
+
+A file that is not a readable mpipd run file gives one line on stderr and exit status 2.
 """
 from __future__ import annotations
 
@@ -14,9 +20,13 @@ import sys
 
 import numpy as np
 
-from .reader import Run
+from .reader import Run, RunFileError
 
 AXES = {"x": 0, "y": 1, "z": 2}
+
+
+class UsageError(Exception):
+    """Bad options: one line, exit status 2."""
 
 
 def summary(run: Run, comm) -> list[str]:
@@ -44,10 +54,8 @@ def station_means(run: Run, comm, axis: int, comp: int, stations, tol) -> np.nda
     counts = np.zeros(len(stations))
     for k, s in enumerate(stations):
         m = np.abs(x - s) <= tol
-        sums[:, k] = v[:, m].sum(axis=1)
-        counts[k] = m.sum()
-    comm.Allreduce(MPI.IN_PLACE, sums, op=MPI.SUM)
-    comm.Allreduce(MPI.IN_PLACE, counts, op=MPI.SUM)
+        sums[:, k] = run.level_total(run.per_level(np.where(m[:, None], v.T, 0.0)))
+        counts[k] = comm.allreduce(int(m.sum()), op=MPI.SUM)
     if np.any(counts == 0):
         raise ValueError(f"no points near station(s) {[s for s, c in zip(stations, counts) if not c]}")
     return sums / counts
@@ -141,12 +149,27 @@ def main(argv=None) -> int:
     fr.add_argument("--field", default="damage")
     fr.add_argument("--frame", type=int, default=-1)
     fr.add_argument("--z", type=float, default=None, help="section height (m)")
+    rp = sub.add_parser("report", help="figures and report.md/report.json of one run")
+    rp.add_argument("run")
+    rp.add_argument("--out", default=None, help="directory (default: RUN's folder /report)")
+    rp.add_argument("--times", default=None,
+                    help="comma-separated times (us) for the fracture pattern (default: four "
+                         "saved frames evenly spaced, ending at the last)")
+    cp = sub.add_parser("compare", help="several runs side by side")
+    cp.add_argument("runs", nargs="+")
+    cp.add_argument("--out", default="compare", help="directory (default: ./compare)")
+    cp.add_argument("--labels", default=None, help="comma-separated run labels")
+    cp.add_argument("--view", default="detonation-face",
+                    choices=["detonation-face", "mid", "far-face"],
+                    help="section of the fracture figure (Figs. 19, 22 view the detonation side)")
     args = ap.parse_args(argv)
+    if args.cmd in ("report", "compare"):
+        return _guarded(comm, _analysis_cmd, args, comm)
     try:
         run = Run(args.run, comm)
-    except OSError as e:
+    except RunFileError as e:
         if comm.Get_rank() == 0:
-            print(f"postprocess: error: cannot open {args.run}: {e}", file=sys.stderr)
+            print(f"postprocess: error: {e}", file=sys.stderr)
         return 2
     try:
         if args.cmd == "summary":
@@ -170,6 +193,41 @@ def main(argv=None) -> int:
     finally:
         run.close()
     if comm.Get_rank() == 0:
+        print("\n".join(lines))
+    return 0
+
+
+def _analysis_cmd(args, comm) -> list[str]:
+    from pathlib import Path
+    if args.cmd == "report":
+        from .report import make_report
+        out = args.out or str(Path(args.run).resolve().parent / "report")
+        times = [float(t) for t in args.times.split(",")] if args.times else None
+        return make_report(args.run, out, comm, times)
+    from .compare import make_compare
+    labels = args.labels.split(",") if args.labels else None
+    if labels and len(labels) != len(args.runs):
+        raise UsageError(f"--labels gives {len(labels)} labels for {len(args.runs)} runs")
+    return make_compare(args.runs, args.out, comm, labels, args.view)
+
+
+def _guarded(comm, fn, *args) -> int:
+    """Bad input (a file that is not a run, bad options): one line, exit 2 on every rank.
+    Anything else: the traceback, and the whole job is aborted so no rank hangs."""
+    try:
+        lines = fn(*args)
+    except (RunFileError, UsageError) as e:
+        if comm.Get_rank() == 0:
+            print(f"postprocess: error: {' '.join(str(e).split())}", file=sys.stderr)
+        return 2
+    except Exception:                                     # noqa: BLE001
+        import traceback
+        traceback.print_exc()
+        sys.stderr.flush()
+        if comm.Get_size() > 1:
+            comm.Abort(1)
+        return 1
+    if comm.Get_rank() == 0 and lines:
         print("\n".join(lines))
     return 0
 

@@ -1,30 +1,123 @@
-"""Open a run file collectively and give each rank its slice of global ids."""
+"""Open a run file collectively and give each rank its slice of global ids.
+
+Every rank of ``comm`` opens the file with h5py's ``mpio`` driver and reads only
+its own contiguous gid range ``lo:hi`` of any per-point dataset.  Global ids run
+over z levels (``mpipd.geometry``: gids follow (z, material, part, y, x)), and the
+reading slices are cut on **whole z levels**: a cross-section is then never
+split between ranks, and a sum is formed per z level on the rank that owns the
+level and the per-level partial sums are added in global level order
+(:meth:`Run.level_total`).  So every number is bit-identical whatever the number
+of reading ranks.
+
+A file that is not an mpipd run file (foreign or truncated HDF5, no frames)
+raises :class:`RunFileError` with a one-line message, on every rank alike.
+"""
 from __future__ import annotations
 
-import h5py
 import numpy as np
+
+REQUIRED = ("geometry/x", "geometry/volume", "geometry/part", "geometry/material", "time")
+
+
+class RunFileError(Exception):
+    """The file cannot be analysed (one line, names the file and the reason)."""
+
+
+def _one_line(e) -> str:
+    return " ".join(str(e).split())
 
 
 class Run:
-    """A run file opened by every rank of ``comm``; ``lo:hi`` is this rank's gid slice."""
+    """A run file opened by every rank of ``comm``; ``lo:hi`` is this rank's gid slice
+    (whole z levels); ``levels`` are the local offsets where a z level starts."""
 
     def __init__(self, path, comm):
+        import h5py
         self.comm = comm
-        self.f = h5py.File(path, "r", driver="mpio", comm=comm)
-        self.n_points = int(self.f.attrs["n_points"])
-        self.frames = int(self.f.attrs["frames_written"])
-        r, n = comm.Get_rank(), comm.Get_size()
-        self.lo = self.n_points * r // n
-        self.hi = self.n_points * (r + 1) // n
+        self.path = str(path)
+        self._geo = {}
+        try:
+            self.f = h5py.File(path, "r", driver="mpio", comm=comm)
+        except (OSError, ValueError) as e:
+            raise RunFileError(f"cannot open {path}: {_one_line(e)}") from None
+        try:
+            self._validate()
+            self._partition()
+        except RunFileError:
+            self.f.close()
+            raise
+        except (OSError, KeyError, ValueError, TypeError) as e:
+            self.f.close()
+            raise RunFileError(f"{path}: unreadable run file ({_one_line(e)})") from None
 
+    # ------------------------------------------------------------------ checks
+    def _validate(self):
+        f, path = self.f, self.path
+        for key in ("n_points", "frames_written"):
+            if key not in f.attrs:
+                raise RunFileError(f"{path}: not an mpipd run file (no attribute {key!r})")
+        for key in REQUIRED:
+            if key not in f:
+                raise RunFileError(f"{path}: not an mpipd run file (no dataset /{key})")
+        self.n_points = int(f.attrs["n_points"])
+        self.frames = int(f.attrs["frames_written"])
+        if self.n_points <= 0 or f["geometry/x"].shape != (self.n_points, 3):
+            raise RunFileError(f"{path}: /geometry/x does not hold n_points = {self.n_points} "
+                               "positions")
+        if self.frames <= 0:
+            raise RunFileError(f"{path}: no frames written (the run stopped before its "
+                               "first output)")
+        if f["time"].shape[0] < self.frames:
+            raise RunFileError(f"{path}: /time holds {f['time'].shape[0]} values but "
+                               f"frames_written = {self.frames} (truncated file)")
+        for name in self.f.get("fields", {}):
+            d = f["fields"][name]
+            if d.shape[0] < self.frames or d.shape[1] != self.n_points:
+                raise RunFileError(f"{path}: /fields/{name} has shape {d.shape}, expected "
+                                   f"({self.frames}+, {self.n_points}, ...)")
+
+    def _partition(self):
+        """Cut the naive slices ``N r / n`` forward to the next start of a z level."""
+        from mpi4py import MPI
+        r, n, N = self.comm.Get_rank(), self.comm.Get_size(), self.n_points
+        lo0, hi0 = N * r // n, N * (r + 1) // n
+        a = max(lo0 - 1, 0)
+        z = self.f["geometry/x"][a:hi0, 2]
+        starts = np.flatnonzero(np.diff(z) != 0) + 1 + a     # gids where a new level begins
+        first = int(starts[starts >= lo0][0]) if np.any(starts >= lo0) else N
+        if lo0 == 0:
+            first = 0
+        firsts = self.comm.allgather(first)
+        self.lo = min(firsts[r:]) if r else 0
+        self.hi = min(firsts[r + 1:] + [N])
+        self.hi = max(self.hi, self.lo)
+        zl = self.f["geometry/x"][self.lo:self.hi, 2]
+        self.levels = (np.concatenate(([0], np.flatnonzero(np.diff(zl) != 0) + 1))
+                       if len(zl) else np.zeros(0, dtype=np.int64))
+        self.level_z = zl[self.levels] if len(zl) else np.zeros(0)
+        self.n_levels = self.comm.allreduce(len(self.levels), op=MPI.SUM)
+
+    # ------------------------------------------------------------------ reads
     def geometry(self, name: str) -> np.ndarray:
-        return self.f["geometry"][name][self.lo:self.hi]
+        """This rank's slice of ``/geometry/name`` (read once, then cached)."""
+        if name not in self._geo:
+            self._geo[name] = self.f["geometry"][name][self.lo:self.hi]
+        return self._geo[name]
 
-    def field(self, name: str, frame=slice(None)) -> np.ndarray:
-        if name not in self.f["fields"]:
+    def has_field(self, name: str) -> bool:
+        return "fields" in self.f and name in self.f["fields"]
+
+    @property
+    def field_names(self) -> list[str]:
+        return list(self.f["fields"]) if "fields" in self.f else []
+
+    def field(self, name: str, frame=slice(None), span=None) -> np.ndarray:
+        """``/fields/name[frame, lo:hi]`` (or ``[frame, lo + a : lo + b]`` for span (a, b))."""
+        if not self.has_field(name):
             raise KeyError(f"the run has no field {name!r} "
-                           f"(it has: {', '.join(self.f['fields'])})")
-        return self.f["fields"][name][frame, self.lo:self.hi]
+                           f"(it has: {', '.join(self.field_names) or 'none'})")
+        a, b = (0, self.hi - self.lo) if span is None else span
+        return self.f["fields"][name][frame, self.lo + a:self.lo + b]
 
     @property
     def time(self) -> np.ndarray:
@@ -32,6 +125,75 @@ class Run:
 
     def energy(self, name: str) -> np.ndarray:
         return self.f["energy"][name][: self.frames]
+
+    def has_energy(self, name: str) -> bool:
+        return "energy" in self.f and name in self.f["energy"]
+
+    def attr(self, key, default=None):
+        v = self.f.attrs.get(key, default)
+        return v.decode() if isinstance(v, bytes) else v
+
+    # ------------------------------------------------------------- reductions
+    def per_level(self, values: np.ndarray) -> np.ndarray:
+        """Sums of ``values`` (local points first, any trailing shape) over each local
+        z level; rows = local levels."""
+        if len(self.levels) == 0:
+            return np.zeros((0,) + values.shape[1:])
+        return np.add.reduceat(values, self.levels, axis=0)
+
+    def per_level_bins(self, bins: np.ndarray, mask: np.ndarray, nb: int,
+                       weights: np.ndarray | None = None) -> np.ndarray:
+        """(local levels, nb) sums of ``weights`` (or counts) of the masked points by
+        (z level, bin); points are added in gid order, so a level's row does not
+        depend on the reading ranks."""
+        n = self.hi - self.lo
+        lev = np.zeros(n, dtype=np.int64)
+        if len(self.levels) > 1:
+            lev[self.levels[1:]] = 1
+            lev = np.cumsum(lev)
+        key = lev[mask] * nb + bins[mask]
+        w = None if weights is None else weights[mask]
+        return np.bincount(key, weights=w, minlength=len(self.levels) * nb
+                           ).astype(float).reshape(len(self.levels), nb)
+
+    def all_levels(self, local: np.ndarray) -> np.ndarray:
+        """Per-level rows of every rank, in global level order (every rank gets them)."""
+        parts = self.comm.allgather(np.asarray(local))
+        return np.concatenate(parts, axis=0)
+
+    def level_total(self, local: np.ndarray) -> np.ndarray:
+        """Sum over all z levels of per-level rows, in global level order: the same
+        floating-point result on any number of ranks."""
+        return self.all_levels(local).sum(axis=0)
+
+    def max(self, x):
+        from mpi4py import MPI
+        return self.comm.allreduce(x, op=MPI.MAX)
+
+    def min(self, x):
+        from mpi4py import MPI
+        return self.comm.allreduce(x, op=MPI.MIN)
+
+    def sum_int(self, x):
+        from mpi4py import MPI
+        return self.comm.allreduce(x, op=MPI.SUM)
+
+    def max_array(self, x: np.ndarray) -> np.ndarray:
+        from mpi4py import MPI
+        out = np.empty_like(x)
+        self.comm.Allreduce(np.ascontiguousarray(x), out, op=MPI.MAX)
+        return out
+
+    def sum_array(self, x: np.ndarray) -> np.ndarray:
+        """Elementwise sum over ranks of an integer array (exact in any order)."""
+        from mpi4py import MPI
+        out = np.empty_like(x)
+        self.comm.Allreduce(np.ascontiguousarray(x), out, op=MPI.SUM)
+        return out
+
+    @property
+    def root(self) -> bool:
+        return self.comm.Get_rank() == 0
 
     def close(self):
         self.f.close()

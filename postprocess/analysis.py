@@ -1,0 +1,210 @@
+"""All the report's measures of one run (paper §3.2–3.5), computed collectively.
+
+``analyse(run, model)`` returns ``(metrics, data)``:
+
+* ``metrics`` — JSON-ready numbers, the same on every rank (what report.md,
+  report.json and ``compare`` print); a measure that cannot be computed is
+  ``{"not_available": reason}``;
+* ``data`` — the gathered sections, the axial plane and the probes, on rank 0
+  only (what the figures draw).
+
+Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
+sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
+headline is the mean over the three sections for crack density and the crushed
+zone, and the median for the count of major radial cracks.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import cracks, probe_metrics as pm, sections as secs, volume
+from .targets import TARGETS, verdict
+
+CRACK_SECTIONS = (secs.NAMED[0], secs.NAMED[2], secs.NAMED[4])
+PPV_THRESHOLD = 2.5          # m/s: the paper's "2500" (mm/s) of Bauer & Calder, Fig. 18
+
+
+def pattern_frames(times, n=4, wanted_us=None) -> list[int]:
+    """Frames shown in the fracture pattern (Fig. 9: 4, 20, 40, 60 us): the frames
+    nearest ``wanted_us``, or ``n`` frames evenly spaced after t = 0 ending at the last."""
+    last = len(times) - 1
+    if wanted_us:
+        return sorted({int(np.argmin(np.abs(np.asarray(times) * 1e6 - w))) for w in wanted_us})
+    if last == 0:
+        return [0]
+    return sorted({int(round(v)) for v in np.linspace(last / n, last, n)})
+
+
+def profile_frames(times, n=4) -> list[int]:
+    """Frames for the explosive pressure along the borehole (Fig. 7: 2, 5, 8, 12 us)."""
+    want = [2e-6, 5e-6, 8e-6, 12e-6]
+    t = np.asarray(times)
+    if t[-1] >= want[-1]:
+        return sorted({int(np.argmin(np.abs(t - w))) for w in want})
+    return sorted({int(round(v)) for v in np.linspace((len(t) - 1) / n, len(t) - 1, n)})
+
+
+def _fracture(data_sections, model, last) -> dict:
+    out = {}
+    crit = None
+    for name, z in data_sections["levels"].items():
+        if name not in CRACK_SECTIONS:
+            continue
+        sec = data_sections["sections"][z]
+        try:
+            failed, crit = cracks.failed_points(sec, last)
+        except KeyError as e:
+            return {"not_available": str(e).strip("'\"")}
+        args = (sec["x"], sec["y"], failed, model.center, model.dx, model.r_wall, model.r_out)
+        out[name] = {"z_mm": z * 1e3, "zones": cracks.crack_density(*args),
+                     "radial_cracks": cracks.radial_cracks(*args, horizon=model.horizon),
+                     "crushed_zone": cracks.crushed_zone(*args)}
+    names = [n for n in CRACK_SECTIONS if n in out]
+    dens = [[out[n]["zones"][k]["density_mm_per_mm2"] for n in names] for k in range(3)]
+    return {"criterion": crit, "sections": out,
+            "mean_density_mm_per_mm2": [float(np.mean(d)) for d in dens],
+            "major_radial_cracks": float(np.median([out[n]["radial_cracks"]["count"]
+                                                    for n in names])),
+            "crushed_extent_borehole_radii": float(np.mean(
+                [out[n]["crushed_zone"]["extent_borehole_radii"] for n in names])),
+            "crushed_extent_mm": float(np.mean([out[n]["crushed_zone"]["extent_mm"]
+                                                for n in names]))}
+
+
+def _ppv_radius(ppv, profile) -> dict:
+    """Distance from the wall within which PPV > 2.5 m/s: from the probes' power law
+    (inside the probes' distance range only), else from the frame profile."""
+    fit = ppv.get("fit", {}) if isinstance(ppv, dict) else {}
+    if "n" in fit and fit["n"] > 0:
+        d = (fit["C"] / PPV_THRESHOLD) ** (1.0 / fit["n"])
+        ds = [p["d_mm"] for p in ppv["points"] if p["peak_inside_record"]]
+        if min(ds) <= d <= max(ds):
+            return {"value_mm": d, "source": "Holmberg–Persson fit to the probes"}
+    if "mean_m_s" in profile:
+        above = np.asarray(profile["mean_m_s"]) > PPV_THRESHOLD
+        d = np.asarray(profile["d_mm"])
+        if above.all():
+            return {"not_available": "PPV exceeds 2.5 m/s over the whole specimen"}
+        if above[0]:
+            k = int(np.argmin(above))
+            return {"value_mm": float(d[k - 1] + 0.5 * (d[1] - d[0] if len(d) > 1 else 0)),
+                    "source": "frame profile (ring means; frames undersample the peak)"}
+        return {"not_available": "PPV is below 2.5 m/s already at the wall"}
+    return {"not_available": "no probes A-G and no v field"}
+
+
+def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
+    times = run.time
+    last = run.frames - 1
+    frames = pattern_frames(times, wanted_us=pattern_us)
+    if last not in frames:
+        frames.append(last)
+    levels = secs.rock_levels(run, model)
+    named = secs.named_levels(levels, model)
+    reqs = [("damage", k) for k in frames] + [("failure_mode", last)]
+    gathered = secs.gather_sections(run, model, list(named.values()), reqs)
+    sec_data = {"levels": named, "sections": gathered}
+    prof_frames = profile_frames(times)
+    vol = volume.scan(run, model, prof_frames)
+    plane = (secs.gather_plane(run, model, "pressure", prof_frames)
+             if run.has_field("pressure") else None)
+    probes = pm.load_probes(run, model)
+    radial = pm.radial_stress(probes)
+    metrics = {"model": model.summary(), "frames": run.frames,
+               "t_end_us": float(times[-1]) * 1e6, "pattern_frames": frames,
+               "pattern_times_us": [float(times[k]) * 1e6 for k in frames],
+               "sections_mm": {k: v * 1e3 for k, v in named.items()},
+               "radial_stress": radial, "wave_speed": pm.wave_speed(radial),
+               "ppv": pm.ppv(probes), "pressure_stress": pm.pressure_stress(probes),
+               "probes": {n: {"d_mm": p["d"] * 1e3, "gid": p["gid"]} for n, p in probes.items()}}
+    metrics.update({k: vol[k] for k in ("energy", "ppv_profile", "wall_pressure",
+                                        "wall_radial_stress", "gas_pressure", "failure_modes")})
+    metrics["gas_profiles"] = vol.get("gas_profiles", [])
+    metrics["time_us"] = [t * 1e6 for t in vol["time_s"]]
+    metrics["global_energy_J"] = {k: run.energy(k).tolist() for k in
+                                  ("kinetic", "strain", "gas", "external", "total")
+                                  if run.has_energy(k)}
+    fr = _fracture(sec_data, model, last) if run.root else None
+    metrics["fracture"] = run.comm.bcast(fr, root=0)
+    metrics["ppv_radius"] = _ppv_radius(metrics["ppv"], metrics["ppv_profile"])
+    metrics["targets"] = targets_table(metrics)
+    data = {"sections": sec_data, "plane": plane, "probes": probes,
+            "plane_frames": prof_frames} if run.root else None
+    return metrics, data
+
+
+def _point(block, name, key):
+    if "not_available" in block:
+        return block
+    for p in block.get("points", []):
+        if p["name"] == name:
+            return p[key]
+    return {"not_available": f"no probe {name}"}
+
+
+def _get(block, *keys):
+    """``block[k1][k2]...``, or the first ``{"not_available": ...}`` met on the way."""
+    for k in keys:
+        if isinstance(block, dict) and "not_available" in block:
+            return block
+        try:
+            block = block[k]
+        except (KeyError, IndexError, TypeError):
+            return {"not_available": f"no {k}"}
+    return block
+
+
+def target_values(m: dict) -> dict:
+    fr = m["fracture"]
+    dens = fr.get("mean_density_mm_per_mm2") if "not_available" not in fr else None
+    ps = m["pressure_stress"]
+
+    def yields(name):
+        y = _point(ps, name, "yielded")
+        return y if isinstance(y, dict) else float(bool(y))
+    return {
+        "wave_speed": _get(m["wave_speed"], "speed_m_s"),
+        "peak_sigma_rr_A": _point(m["radial_stress"], "A", "peak_MPa"),
+        "peak_sigma_rr_G": _point(m["radial_stress"], "G", "peak_MPa"),
+        "attenuation_n": _get(m["radial_stress"], "fit", "n"),
+        **{f"crack_density_zone{k + 1}": (dens[k] if dens else fr) for k in range(3)},
+        "major_radial_cracks": _get(fr, "major_radial_cracks"),
+        "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
+        "ppv_radius_2p5": _get(m["ppv_radius"], "value_mm"),
+        "peak_gas_pressure": _get(m["gas_pressure"], "peak_MPa"),
+        "peak_wall_pressure": _get(m["wall_radial_stress"] if "peak_MPa" in
+                                   m["wall_radial_stress"] else m["wall_pressure"], "peak_MPa"),
+        "P1_yields": yields("P1"), "P2_yields": yields("P2"), "P3_yields": yields("P3"),
+    }
+
+
+def _bases(m: dict) -> dict:
+    """How each headline value was formed (shown beside it)."""
+    fr = m["fracture"]
+    ns = len(fr.get("sections", {}))
+    ws, rs = m["wave_speed"], m["radial_stress"]
+    out = {"wave_speed": f"{len(ws['probes'])} probes" if "probes" in ws else "",
+           "attenuation_n": (f"{rs['fit']['n_points']} probes"
+                             if "fit" in rs and "n_points" in rs["fit"] else ""),
+           "major_radial_cracks": f"median of {ns} sections",
+           "crushed_zone": f"mean of {ns} sections",
+           "ppv_radius_2p5": m["ppv_radius"].get("source", ""),
+           "peak_gas_pressure": "saved frames",
+           "peak_wall_pressure": ("−σ_rr, saved frames" if "peak_MPa" in m["wall_radial_stress"]
+                                  else "mean pressure, saved frames")}
+    out.update({f"crack_density_zone{k}": f"mean of {ns} sections" for k in (1, 2, 3)})
+    return out
+
+
+def targets_table(m: dict) -> list[dict]:
+    vals = target_values(m)
+    bases = _bases(m)
+    rows = []
+    for t in TARGETS:
+        v = vals[t.key]
+        rows.append({"key": t.key, "label": t.label, "unit": t.unit,
+                     "value": None if isinstance(v, dict) else float(v),
+                     "basis": bases.get(t.key, "") if not isinstance(v, dict) else "",
+                     "paper": t.paper, "experiment": t.experiment, "band": t.band,
+                     "verdict": verdict(t.key, v)})
+    return rows

@@ -1,0 +1,129 @@
+"""Fracture measures on one cross-section of the rock (paper §3.2, Figs. 6, 9–12).
+
+A point counts as **failed** (cracked) when its damage phi = 1 (Eq. 39; the
+paper: "the fracture is represented by the damage of material points, i.e.
+with damage equal to one"), tested as phi >= 1 - 1e-9.  If a run has no damage
+field, failure_mode != 0 is used instead, and the report says so.
+
+Crack density (Fig. 12).  The rock between the borehole wall R_b and the outer
+boundary R_o is cut into three rings of equal width w = (R_o - R_b)/3
+(zone k: R_b + (k-1) w <= r < R_b + k w).  On a section, each failed point
+stands for a crack of length dx (the paper: 0.8 mm per damaged point), so
+
+    density_k = n_failed,k * dx / (pi [(R_b + k w)^2 - (R_b + (k-1) w)^2])
+
+in mm/mm^2 (the geometric area of the ring on the section).
+
+Major radial cracks (§3.2: six reach the outer boundary).  A peridynamic model
+does not resolve two cracks closer than its horizon delta, and the failed points
+of a crack on a section are a chain with gaps.  So failed points closer than
+delta to each other (in max(|dx|, |dy|); delta = the rock's horizon, 3 dx by
+default) belong to the same crack, and the failed points in the outer band
+R_o - 2 dx <= r are split into arcs wherever two neighbours (by angle) are more
+than delta apart along the boundary.  An arc is a major radial crack when its
+crack also reaches zone 1 (r < R_b + w): it runs from the borehole region to the
+boundary.  Spalls and boundary chips that do not connect inward are not counted.
+
+Crushed zone (§3.2: "all points within a zone of approximately one radius of the
+borehole are damaged").  The failed fraction is taken in rings of width dx from
+the wall outward; the crushed zone ends at the outer edge of the last ring of
+the unbroken run from the wall in which at least 90 % of the points have
+failed.  Its extent d_c = r_c - R_b is reported, also in borehole radii.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+FAILED_PHI = 1.0 - 1e-9
+CRUSH_FRACTION = 0.9
+BAND = 2.0          # outer band width, in dx
+
+
+def failed_points(sec: dict, frame: int) -> tuple[np.ndarray, str]:
+    """Boolean failed mask of a gathered section and the criterion used."""
+    if ("damage", frame) in sec:
+        return sec[("damage", frame)] >= FAILED_PHI, "damage phi = 1"
+    if ("failure_mode", frame) in sec:
+        return sec[("failure_mode", frame)] != 0, "failure_mode != 0 (no damage field)"
+    raise KeyError("neither damage nor failure_mode was written")
+
+
+def zone_edges(r_wall: float, r_out: float) -> np.ndarray:
+    return r_wall + (r_out - r_wall) * np.arange(4) / 3.0
+
+
+def crack_density(x, y, failed, center, dx, r_wall, r_out) -> list[dict]:
+    """Per zone: failed count, crack length (mm), ring area (mm^2), density (mm/mm^2)."""
+    r = np.hypot(np.asarray(x) - center[0], np.asarray(y) - center[1])
+    e = zone_edges(r_wall, r_out)
+    out = []
+    for k in range(3):
+        inside = (r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * dx))
+        n = int(np.count_nonzero(failed & inside))
+        length = n * dx * 1e3
+        area = np.pi * (e[k + 1] ** 2 - e[k] ** 2) * 1e6
+        out.append({"zone": k + 1, "r_mm": [e[k] * 1e3, e[k + 1] * 1e3], "failed_points": n,
+                    "points": int(np.count_nonzero(inside)), "crack_length_mm": length,
+                    "area_mm2": area, "density_mm_per_mm2": length / area})
+    return out
+
+
+def _cracks(x, y, failed, link):
+    """Crack labels per point (0 = not failed): failed points within ``link`` of each
+    other (max-norm) are joined."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+    idx = np.flatnonzero(failed)
+    pairs = cKDTree(np.column_stack([x[idx], y[idx]])).query_pairs(
+        link * (1 + 1e-9), p=np.inf, output_type="ndarray")
+    g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(idx),) * 2)
+    _, lab = connected_components(g, directed=False)
+    out = np.zeros(len(x), dtype=np.int64)
+    out[idx] = lab + 1
+    return out
+
+
+def radial_cracks(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict:
+    """Count of cracks that run from zone 1 to the outer boundary, and their angles."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    link = 3.0 * dx if horizon is None else horizon
+    r = np.hypot(x - center[0], y - center[1])
+    band = failed & (r >= r_out - BAND * dx)
+    if not np.any(band):
+        return {"count": 0, "angles_deg": [], "boundary_arcs": 0, "link_mm": link * 1e3}
+    lab = _cracks(x, y, failed, link)
+    inner = set(np.unique(lab[failed & (r < zone_edges(r_wall, r_out)[1])]).tolist()) - {0}
+    th = np.arctan2(y[band] - center[1], x[band] - center[0])
+    order = np.argsort(th)
+    th, lb = th[order], lab[band][order]
+    gap = link / r_out
+    cut = np.flatnonzero(np.diff(th) > gap) + 1
+    arcs = np.split(np.arange(len(th)), cut)
+    if len(arcs) > 1 and th[0] + 2 * np.pi - th[-1] <= gap:      # wraps across +-pi
+        arcs[0] = np.concatenate([arcs[-1], arcs[0]])
+        arcs.pop()
+    major = []
+    for a in arcs:
+        if inner & set(lb[a].tolist()):
+            c, s = np.cos(th[a]).mean(), np.sin(th[a]).mean()
+            major.append(float(np.degrees(np.arctan2(s, c)) % 360.0))
+    return {"count": len(major), "angles_deg": sorted(major), "boundary_arcs": len(arcs),
+            "link_mm": link * 1e3}
+
+
+def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
+    """Outer radius of the unbroken run of >= 90 % failed rings from the wall."""
+    r = np.hypot(np.asarray(x) - center[0], np.asarray(y) - center[1])
+    nb = max(1, int(np.ceil((r_out - r_wall) / dx)))
+    k = np.clip(((r - r_wall) / dx).astype(int), 0, nb - 1)
+    tot = np.bincount(k, minlength=nb)
+    bad = np.bincount(k[failed], minlength=nb)
+    frac = np.where(tot > 0, bad / np.maximum(tot, 1), 0.0)
+    run = 0
+    while run < nb and (tot[run] == 0 or frac[run] >= CRUSH_FRACTION):
+        run += 1
+    rc = r_wall + run * dx
+    return {"r_c_mm": rc * 1e3, "extent_mm": (rc - r_wall) * 1e3,
+            "extent_borehole_radii": (rc - r_wall) / r_wall,
+            "failed_fraction_by_ring": frac[:max(run + 3, 1)].round(4).tolist()}

@@ -1,0 +1,172 @@
+"""What the analysis needs to know about the modelled specimen (paper Fig. 6).
+
+The borehole axis ``center`` (x, y), the borehole-wall radius ``r_wall`` (the
+rock part's inner radius: the copper tube sits inside the borehole), the outer
+radius ``r_out``, the rock's thickness ``z0..z1`` and lattice spacing ``dx``,
+the rock's horizon, the densities and the JH2 parameters are read from the scene text stored in the
+run file (``attrs['scene']``, parsed with :func:`mpipd.scene.parse` together with
+the ``--set`` overrides recorded after ``# overrides (--set)``).  If the scene
+cannot be parsed, or the rock is not an annulus, they fall back to the geometry:
+
+    r_wall = min r - dx/2,   r_out = max r + dx/2,   dx = V^(1/3)
+
+over the rock points (exact for the lattice of ``mpipd.geometry``: cell centres
+at half-integer multiples of dx).  Which fallback was used is in ``notes``.
+
+The rock is the part named ``rock``; else the part of a ``jh2`` material; else
+the largest part.  The charge is the part of a ``jwl`` material (or ``charge``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+OVERRIDES_MARK = "# overrides (--set)"
+
+
+def split_scene_text(text: str) -> tuple[str, list[str]]:
+    """The stored scene text and the ``--set`` overrides listed after the mark."""
+    if OVERRIDES_MARK not in text:
+        return text, []
+    head, tail = text.split(OVERRIDES_MARK, 1)
+    sets = [ln[1:].strip() for ln in tail.splitlines() if ln.startswith("#") and "=" in ln]
+    return head, sets
+
+
+@dataclass
+class Model:
+    label: str
+    scene_name: str
+    center: tuple[float, float]
+    r_wall: float
+    r_out: float
+    z0: float
+    z1: float
+    dx: float
+    rock: int                                   # part index of the rock
+    charge: int | None                          # part index of the explosive (or None)
+    part_names: list[str]
+    material_names: list[str]
+    density: dict = field(default_factory=dict)  # material id -> kg/m^3
+    jh2: object = None                           # the rock's JH2 material (or None)
+    pressure_factor: float | None = None
+    horizon: float | None = None                 # the rock's horizon (m); None -> 3 dx
+    overrides: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+
+    @property
+    def thickness(self) -> float:
+        return self.z1 - self.z0
+
+    def radius(self, x: np.ndarray) -> np.ndarray:
+        return np.hypot(x[:, 0] - self.center[0], x[:, 1] - self.center[1])
+
+    def summary(self) -> dict:
+        return {"scene": self.scene_name, "center_m": list(self.center), "r_wall_m": self.r_wall,
+                "r_out_m": self.r_out, "z_m": [self.z0, self.z1], "dx_m": self.dx,
+                "horizon_m": self.horizon,
+                "rock_part": self.part_names[self.rock],
+                "charge_part": None if self.charge is None else self.part_names[self.charge],
+                "pressure_factor": self.pressure_factor, "overrides": self.overrides,
+                "notes": self.notes}
+
+
+def _names(run, key) -> list[str]:
+    names = run.f["geometry"][key].attrs.get("names", [])
+    return [n.decode() if isinstance(n, bytes) else str(n) for n in names]
+
+
+def _parse_scene(run, notes):
+    text = run.attr("scene")
+    if not text:
+        notes.append("the run file stores no scene text: geometry from the points")
+        return None, []
+    body, sets = split_scene_text(str(text))
+    try:
+        from mpipd.scene import parse
+        return parse(body, "stored scene", sets), sets
+    except Exception as e:                                  # noqa: BLE001 (SceneError, ImportError)
+        notes.append(f"the stored scene does not parse ({' '.join(str(e).split())}): "
+                     "geometry from the points")
+        return None, sets
+
+
+def _pick(names, models, want_name, want_model):
+    if want_name in names:
+        return names.index(want_name)
+    for k, m in enumerate(models):
+        if m == want_model:
+            return k
+    return None
+
+
+def load_model(run, label: str | None = None) -> Model:
+    """Collective: every rank gets the same :class:`Model`."""
+    notes: list[str] = []
+    parts = _names(run, "part")
+    mats = _names(run, "material")
+    scene, sets = _parse_scene(run, notes)
+    part_mat = {}
+    models = [None] * len(parts)
+    if scene is not None:
+        sparts = {p.name: p for p in scene.parts}
+        for k, name in enumerate(parts):
+            if name in sparts:
+                part_mat[k] = sparts[name].material
+                models[k] = scene.materials[sparts[name].material].registry_name
+    # point counts per part decide when names and models do not
+    pid = run.geometry("part")
+    counts = run.sum_array(np.bincount(pid, minlength=len(parts)).astype(np.int64))
+    rock = _pick(parts, models, "rock", "jh2")
+    if rock is None:
+        rock = int(np.argmax(counts))
+        notes.append(f"no part named 'rock' or of a jh2 material: the largest part "
+                     f"{parts[rock]!r} is taken as the rock")
+    charge = _pick(parts, models, "charge", "jwl")
+    x = run.geometry("x")
+    sel = pid == rock
+    vol = run.geometry("volume")[sel]
+    xr = x[sel]
+    dx_geo = float(np.cbrt(run.max(float(vol.max()) if len(vol) else 0.0)))
+    shape = None
+    if scene is not None and parts[rock] in {p.name for p in scene.parts}:
+        spart = next(p for p in scene.parts if p.name == parts[rock])
+        shape = spart.shape
+        dx = spart.dx
+        horizon = spart.horizon
+    else:
+        dx = dx_geo
+        horizon = 3.0 * dx
+        notes.append("the rock's horizon is not known from the scene: 3 dx assumed")
+    if shape is not None and hasattr(shape, "inner_radius"):
+        center = (float(shape.center[0]), float(shape.center[1]))
+        r_wall, r_out = float(shape.inner_radius), float(shape.radius)
+        z0, z1 = float(shape.z[0]), float(shape.z[1])
+    else:
+        if shape is not None:
+            notes.append(f"the rock part is a {type(shape).__name__.lower()}, not an annulus: "
+                         "borehole radius from the points")
+        lo = [run.min(float(xr[:, k].min()) if len(xr) else np.inf) for k in range(3)]
+        hi = [run.max(float(xr[:, k].max()) if len(xr) else -np.inf) for k in range(3)]
+        center = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))
+        r = np.hypot(xr[:, 0] - center[0], xr[:, 1] - center[1])
+        r_wall = run.min(float(r.min()) if len(r) else np.inf) - 0.5 * dx
+        r_out = run.max(float(r.max()) if len(r) else 0.0) + 0.5 * dx
+        z0, z1 = lo[2] - 0.5 * dx, hi[2] + 0.5 * dx
+    density, jh2, pf = {}, None, None
+    if scene is not None:
+        for mid, name in enumerate(mats):
+            if name in scene.materials:
+                density[mid] = float(scene.materials[name].density)
+        rock_mat = scene.materials.get(part_mat.get(rock))
+        if rock_mat is not None and rock_mat.registry_name == "jh2":
+            jh2 = rock_mat
+        if charge is not None and part_mat.get(charge) in scene.materials:
+            pf = getattr(scene.materials[part_mat[charge]], "pressure_factor", None)
+    name = str(run.attr("scene_name", scene.name if scene is not None else "unknown"))
+    return Model(label=label or name, scene_name=name, center=center, r_wall=r_wall,
+                 r_out=r_out, z0=z0, z1=z1, dx=float(dx), rock=rock, charge=charge,
+                 part_names=parts, material_names=mats, density=density, jh2=jh2,
+                 pressure_factor=pf, horizon=float(horizon), overrides=sets, notes=notes)
+

@@ -1,0 +1,153 @@
+"""Metrics from the probes, recorded every step (``/probes/<name>``, mpipd.probes).
+
+Probes A–G sit at 6.8, 10.8, 22, 29.2, 39.6, 50 and 59.6 mm from the borehole
+wall, P1–P3 at 0.8, 1.6 and 4.8 mm (paper Figs. 6, 15).  A probe's distance d
+is measured from its actual lattice point, d = |x - x_c| - R_b.
+
+* Radial stress (Fig. 16a) and its attenuation (Fig. 17): the peak compressive
+  radial stress p = max_t(-sigma_rr) at each of A–G, fitted with p = C d^-n
+  (d in mm, p in MPa; paper: ~130 MPa at A, < 20 MPa at G, n = 0.798).  A probe
+  whose peak is the last recorded step (the wave has not passed it yet) is shown
+  but left out of the fits and of the wave speed.
+* Wave speed (Fig. 16b): the arrival time t_k of that peak at each of A–G (the
+  largest sample refined by a parabola); the slope of d against t is the speed
+  (paper 4270 m/s; measured P-wave speed 4535 m/s).
+* PPV (Fig. 18): max_t |v_r| at each of A–G, fitted with the Holmberg–Persson
+  law PPV = K d^-beta.
+* Pressure–stress paths (Fig. 15): (p, s) at P1–P3 against the JH2 strength
+  recorded at the point (sigma_y at its p*, edot*, D; Eqs. 21–23) and the intact
+  and fractured envelopes at edot* = 1:
+      sigma_i = sigma_HEL A (p* + T*)^N,  sigma_f = sigma_HEL B p*^M.
+  A point has yielded once s >= 0.99 sigma_y with sigma_y > 0 (paper: P1 yields at
+  p ~ 200 MPa, P2 at s ~ 150 MPa, P3 never reaches its strength).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import fits
+
+SERIES = {"A": 6.8, "B": 10.8, "C": 22.0, "D": 29.2, "E": 39.6, "F": 50.0, "G": 59.6}
+PATHS = {"P1": 0.8, "P2": 1.6, "P3": 4.8}
+QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
+YIELD_TOL = 0.99
+
+
+def na(reason: str) -> dict:
+    return {"not_available": reason}
+
+
+def load_probes(run, model) -> dict:
+    """name -> {gid, x, d (m), t, sigma_rr, v_r, p, s, strength}; rows never written
+    (NaN) are dropped.  Read by rank 0, broadcast (probes are small)."""
+    out = None
+    if run.root:
+        out = {}
+        grp = run.f.get("probes")
+        for name in (grp or {}):
+            g = grp[name]
+            if not all(q in g for q in QUANTITIES) or "gid" not in g.attrs:
+                continue
+            data = {q: g[q][...] for q in QUANTITIES}
+            keep = np.isfinite(data["t"])
+            data = {q: a[keep] for q, a in data.items()}
+            gid = int(g.attrs["gid"])
+            x = run.f["geometry/x"][gid]
+            data.update(gid=gid, x=x.tolist(),
+                        d=float(np.hypot(x[0] - model.center[0], x[1] - model.center[1])
+                                - model.r_wall))
+            out[name] = data
+    return run.comm.bcast(out, root=0)
+
+
+def _series(probes, names):
+    have = [n for n in names if n in probes and len(probes[n]["t"]) > 2]
+    missing = [n for n in names if n not in have]
+    return have, missing
+
+
+def radial_stress(probes) -> dict:
+    have, missing = _series(probes, SERIES)
+    if not have:
+        return na("no probes named A-G with recorded steps")
+    pts = []
+    for n in have:
+        q = probes[n]
+        t, pk, interior = fits.peak_time(q["t"], -q["sigma_rr"])
+        pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": SERIES[n],
+                    "peak_MPa": pk / 1e6, "t_peak_us": t * 1e6, "peak_inside_record": interior})
+    out = {"points": pts, "missing": missing}
+    out["fit"] = _fit([p for p in pts if p["peak_inside_record"]], "peak_MPa")
+    out["excluded_from_fit"] = [p["name"] for p in pts if not p["peak_inside_record"]]
+    return out
+
+
+def _fit(pts, key) -> dict:
+    """Power law over the probes whose peak lies inside the record (a peak at the last
+    step means the wave has not yet passed: that probe's peak is not known)."""
+    try:
+        return fits.power_law([p["d_mm"] for p in pts], [p[key] for p in pts])
+    except fits.FitError as e:
+        return na(f"{e} (probes whose peak is at the end of the record are left out)")
+
+
+def wave_speed(radial: dict) -> dict:
+    if "points" not in radial:
+        return na(radial["not_available"])
+    pts = [p for p in radial["points"] if p["peak_inside_record"]]
+    late = [p["name"] for p in radial["points"] if not p["peak_inside_record"]]
+    try:
+        f = fits.line([p["t_peak_us"] * 1e-6 for p in pts], [p["d_mm"] * 1e-3 for p in pts])
+    except fits.FitError as e:
+        return na(f"{e}; peaks at the end of the record: {', '.join(late) or 'none'}")
+    return {"speed_m_s": f["slope"], "r2": f["r2"], "probes": [p["name"] for p in pts],
+            "excluded_peak_at_record_end": late,
+            "arrivals": [{"name": p["name"], "d_mm": p["d_mm"], "t_us": p["t_peak_us"]}
+                         for p in pts]}
+
+
+def ppv(probes) -> dict:
+    have, missing = _series(probes, SERIES)
+    if not have:
+        return na("no probes named A-G with recorded steps")
+    pts = []
+    for n in have:
+        a = np.abs(probes[n]["v_r"])
+        k = int(np.argmax(a))
+        pts.append({"name": n, "d_mm": probes[n]["d"] * 1e3, "ppv_m_s": float(a[k]),
+                    "peak_inside_record": 0 < k < len(a) - 1})
+    out = {"points": pts, "missing": missing, "source": "probes (every step)"}
+    out["fit"] = _fit([p for p in pts if p["peak_inside_record"]], "ppv_m_s")
+    out["excluded_from_fit"] = [p["name"] for p in pts if not p["peak_inside_record"]]
+    return out
+
+
+def jh2_envelope(jh2, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Intact and fractured JH2 strength (Pa) at pressures p (Pa), edot* = 1."""
+    ps = np.asarray(p, float) / jh2.p_HEL
+    ts = jh2.T / jh2.p_HEL
+    si = jh2.sigma_hel * jh2.A * np.clip(ps + ts, 0, None) ** jh2.N
+    sf = jh2.sigma_hel * jh2.B * np.clip(ps, 0, None) ** jh2.M
+    return si, sf
+
+
+def pressure_stress(probes) -> dict:
+    have, missing = _series(probes, PATHS)
+    if not have:
+        return na("no probes named P1-P3 with recorded steps")
+    pts = []
+    for n in have:
+        q = probes[n]
+        st = q["strength"]
+        yl = np.flatnonzero(np.isfinite(st) & (st > 0) & (q["s"] >= YIELD_TOL * st))
+        first = int(yl[0]) if len(yl) else None
+        failed = np.flatnonzero(np.isfinite(st) & (st == 0) & (q["s"] == 0))
+        pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": PATHS[n],
+                    "peak_p_MPa": float(q["p"].max()) / 1e6,
+                    "peak_s_MPa": float(q["s"].max()) / 1e6,
+                    "yielded": first is not None,
+                    "p_at_yield_MPa": None if first is None else float(q["p"][first]) / 1e6,
+                    "s_at_yield_MPa": None if first is None else float(q["s"][first]) / 1e6,
+                    "failed_at_us": float(q["t"][failed[0]]) * 1e6 if len(failed) else None,
+                    "strength_recorded": bool(np.isfinite(st).any())})
+    return {"points": pts, "missing": missing}

@@ -1,0 +1,118 @@
+"""``python -m postprocess report RUN.h5 [--out DIR]``: the paper's figures of one
+run and a validation report (``report.md``, the same numbers in ``report.json``).
+
+All ranks read and reduce (:mod:`postprocess.analysis`); rank 0 draws the figures
+and writes the files.  The JSON holds only numbers derived from the run file, so
+it is identical whatever the number of reading ranks.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from . import figures_curves as fc, figures_maps as fmap
+from .analysis import analyse
+from .model import load_model
+from .reader import Run
+
+
+def run_label(path, model) -> str:
+    p = Path(path).resolve()
+    folder = p.parent.name if p.name == "run.h5" else p.stem
+    return f"{model.scene_name} ({folder})"
+
+
+def _figures(metrics, data, model, times, label, out: Path) -> tuple[dict, dict]:
+    """Draw every figure the data allow: name -> file, and name -> why not."""
+    made, skipped = {}, {}
+    last = metrics["frames"] - 1
+    frames = metrics["pattern_frames"]
+    fr = metrics["fracture"]
+    sec = data["sections"]
+
+    def put(name, why, fn, *args):
+        if why:
+            skipped[name] = why
+        else:
+            made[name] = fn(*args)
+    has_damage = any(("damage", last) in s for s in sec["sections"].values())
+    has_mode = any(("failure_mode", last) in s for s in sec["sections"].values())
+    no_dmg = None if has_damage else "the run has no damage field"
+    put("fig09_fracture_faces", no_dmg, fmap.fracture_pattern, sec, model, times, frames, label,
+        out / "fig09_fracture_faces.png")
+    put("fig11_fracture_sections", no_dmg, fmap.fracture_sections, sec, model, times, frames,
+        label, out / "fig11_fracture_sections.png")
+    put("fig13_failure_modes", None if has_mode else "the run has no failure_mode field",
+        fmap.failure_modes, sec, model, times, last, label, out / "fig13_failure_modes.png")
+    put("fig12_crack_density", fr.get("not_available"), fc.crack_density, fr, label,
+        out / "fig12_crack_density.png")
+    rs = metrics["radial_stress"]
+    put("fig16a_radial_stress", rs.get("not_available"), fc.radial_histories, data["probes"], rs,
+        label, out / "fig16a_radial_stress.png")
+    ws = metrics["wave_speed"]
+    put("fig16b_wave_speed", ws.get("not_available"), fc.arrivals, ws, label,
+        out / "fig16b_wave_speed.png")
+    put("fig17_peak_radial_stress", rs.get("not_available"), fc.peak_stress, rs, label,
+        out / "fig17_peak_radial_stress.png")
+    pv, prof = metrics["ppv"], metrics["ppv_profile"]
+    why = pv.get("not_available") if "not_available" in prof else None
+    put("fig18_ppv", why, fc.ppv, pv, prof, label, out / "fig18_ppv.png")
+    ps = metrics["pressure_stress"]
+    put("fig15_pressure_stress", ps.get("not_available"), fc.pressure_stress, data["probes"], ps,
+        model.jh2, label, out / "fig15_pressure_stress.png")
+    gp = metrics["gas_pressure"]
+    put("fig07_explosive_pressure", gp.get("not_available"), fc.explosive_pressure, metrics,
+        label, out / "fig07_explosive_pressure.png")
+    plane = data["plane"]
+    put("fig07_pressure_plane", None if plane is not None else "the run has no pressure field",
+        fmap.plane_pressure, plane, model, times, data["plane_frames"], label,
+        out / "fig07_pressure_plane.png")
+    put("fig20_rock_energy", metrics["energy"].get("not_available"), fc.energy, metrics, label,
+        out / "fig20_rock_energy.png")
+    return made, skipped
+
+
+def make_report(path, out, comm, pattern_us=None) -> list[str]:
+    run = Run(path, comm)
+    try:
+        model = load_model(run)
+        label = run_label(path, model)
+        model.label = label
+        metrics, data = analyse(run, model, pattern_us)
+        times = run.time
+        info = {"run_file": str(Path(path).resolve()), "label": label,
+                "n_points": run.n_points, "run_ranks": _int(run.attr("ranks")),
+                "dt_s": _float(run.attr("dt")), "steps": _int(run.attr("steps")),
+                "git_commit": str(run.attr("git_commit", "unknown")),
+                "mpipd_version": str(run.attr("mpipd_version", "unknown")),
+                "fields": run.field_names, "bonds_broken": _int(run.attr("bonds_broken"))}
+    finally:
+        run.close()
+    if comm.Get_rank() != 0:
+        return []
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    made, skipped = _figures(metrics, data, model, times, label, out)
+    doc = {"run": info, "figures": made, "figures_not_made": skipped, **metrics}
+    (out / "report.json").write_text(json.dumps(doc, indent=1, default=_json) + "\n")
+    from .report_md import render
+    (out / "report.md").write_text(render(doc))
+    return [f"wrote {out / 'report.md'}, {out / 'report.json'} and {len(made)} figures"
+            + (f" ({len(skipped)} not made: {', '.join(skipped)})" if skipped else "")]
+
+
+def _int(v):
+    return None if v is None else int(v)
+
+
+def _float(v):
+    return None if v is None else float(v)
+
+
+def _json(o):
+    import numpy as np
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)

@@ -1,0 +1,195 @@
+"""``report.md``: the targets table, one section per paper figure, and what could
+not be computed, rendered from the same dict as ``report.json``."""
+from __future__ import annotations
+
+
+def _f(v, fmt=".3g"):
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, (int, float)):
+        return format(v, fmt)
+    return str(v)
+
+
+def _na(block):
+    return isinstance(block, dict) and "not_available" in block
+
+
+def _fig(doc, name):
+    if name in doc["figures"]:
+        return [f"![{name}]({doc['figures'][name]})", ""]
+    return [f"*Figure {name} not made: {doc['figures_not_made'].get(name, 'no data')}.*", ""]
+
+
+def targets_rows(rows) -> list[str]:
+    out = ["| quantity | this run | paper | experiment | range used | verdict |",
+           "|---|---|---|---|---|---|"]
+    for r in rows:
+        v = r["value"]
+        if r["unit"] == "yes/no" and v is not None:
+            shown = "yes" if v else "no"
+        else:
+            shown = _f(v, ".4g") + (f" {r['unit']}" if v is not None and r["unit"] != "—" else "")
+        if r.get("basis"):
+            shown += f" ({r['basis']})"
+        out.append(f"| {r['label']} | {shown} | {r['paper']} | {r['experiment']} | {r['band']} "
+                   f"| **{r['verdict']}** |")
+    return out
+
+
+def render(doc) -> str:
+    run, m = doc["run"], doc["model"]
+    L = [f"# Validation report: {run['label']}", "",
+         f"Run file `{run['run_file']}`: {run['n_points']} points, {doc['frames']} frames to "
+         f"t = {doc['t_end_us']:.3g} µs (dt {_f(run['dt_s'])} s, {_f(run['steps'])} steps, "
+         f"written by {_f(run['run_ranks'])} rank(s)); mpipd {run['mpipd_version']}, "
+         f"commit {run['git_commit'][:12]}.",
+         f"Fields: {', '.join(run['fields']) or 'none'}.  Borehole wall R_b = "
+         f"{m['r_wall_m'] * 1e3:.3g} mm (rock part `{m['rock_part']}`), outer radius R_o = "
+         f"{m['r_out_m'] * 1e3:.4g} mm, thickness {(m['z_m'][1] - m['z_m'][0]) * 1e3:.4g} mm, "
+         f"rock dx = {m['dx_m'] * 1e3:.3g} mm.  Explosive pressure_factor: "
+         f"{_f(m['pressure_factor'])} (1 = the physics of Table 2)."]
+    if m["overrides"]:
+        L.append("Overrides: " + ", ".join(f"`{o}`" for o in m["overrides"]) + ".")
+    L += [f"Note: {n}" for n in m["notes"]]
+    L += ["", "## Targets (paper §3.2–3.5, DESIGN §8)", "",
+          "The verdict compares the run's value with the range in the 'range used' column; "
+          "the ranges are fixed constants (`postprocess/targets.py`), not tuned to runs.", ""]
+    L += targets_rows(doc["targets"])
+    L += ["", "## Fracture pattern (Figs. 9, 11)", "",
+          f"Times shown: {', '.join(f'{t:.3g}' for t in doc['pattern_times_us'])} µs.  Sections "
+          "(z of the rock lattice level used): "
+          + ", ".join(f"{k} {v:.3g} mm" for k, v in doc["sections_mm"].items()) + ".", ""]
+    L += _fig(doc, "fig09_fracture_faces") + _fig(doc, "fig11_fracture_sections")
+    L += ["## Failure modes (Fig. 13)", ""]
+    fm = doc["failure_modes"]
+    L += ["Rock points by failure mode at the last frame: " + (
+        fm["not_available"] if _na(fm) else
+        ", ".join(f"{k} {v}" for k, v in fm.items() if k != "note")) + ".", ""]
+    L += _fig(doc, "fig13_failure_modes")
+    L += _fracture(doc["fracture"]) + _fig(doc, "fig12_crack_density")
+    L += _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _energy(doc)
+    na = [f"- {r['label']}: {r['verdict'][len('not available: '):]}" for r in doc["targets"]
+          if r["verdict"].startswith("not available")]
+    na += [f"- figure {k}: {v}" for k, v in doc["figures_not_made"].items()]
+    L += ["## Not available", ""] + (na or ["Everything was computed."]) + [""]
+    return "\n".join(L) + "\n"
+
+
+def _fracture(fr) -> list[str]:
+    L = ["## Crack density, radial cracks, crushed zone (Fig. 12, §3.2)", ""]
+    if _na(fr):
+        return L + [f"Not available: {fr['not_available']}.", ""]
+    L += [f"Failed point: {fr['criterion']}; crack length = failed points × dx on the section; "
+          "density = length / ring area; three rings of equal width from the wall to the "
+          "outer boundary.", "",
+          "| section | z (mm) | zone 1 | zone 2 | zone 3 | major radial cracks | crushed zone "
+          "(mm beyond wall / R_b) |", "|---|---|---|---|---|---|---|"]
+    for name, s in fr["sections"].items():
+        z = [f"{q['density_mm_per_mm2']:.3f} ({q['failed_points']} pts)" for q in s["zones"]]
+        c = s["crushed_zone"]
+        L.append(f"| {name} | {s['z_mm']:.3g} | {' | '.join(z)} | {s['radial_cracks']['count']}"
+                 f" | {c['extent_mm']:.3g} / {c['extent_borehole_radii']:.2f} |")
+    md = fr["mean_density_mm_per_mm2"]
+    L += [f"| mean | | {md[0]:.3f} | {md[1]:.3f} | {md[2]:.3f} | "
+          f"{fr['major_radial_cracks']:.3g} (median) | {fr['crushed_extent_mm']:.3g} / "
+          f"{fr['crushed_extent_borehole_radii']:.2f} |",
+          "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", ""]
+    return L
+
+
+def _radial(doc) -> list[str]:
+    r, w = doc["radial_stress"], doc["wave_speed"]
+    L = ["## Radial stress and wave speed (Figs. 16, 17)", ""]
+    if _na(r):
+        return L + [f"Not available: {r['not_available']}.", ""]
+    L += ["| probe | d (mm) | paper d (mm) | peak −σ_rr (MPa) | peak time (µs) |",
+          "|---|---|---|---|---|"]
+    L += [f"| {p['name']} | {p['d_mm']:.3g} | {p['paper_d_mm']} | {p['peak_MPa']:.4g} | "
+          f"{p['t_peak_us']:.4g}{'' if p['peak_inside_record'] else ' (end of record)'} |"
+          for p in r["points"]]
+    if r["missing"]:
+        L += ["", f"Probes not in the run: {', '.join(r['missing'])}."]
+    if r.get("excluded_from_fit"):
+        L += ["", f"Left out of the fit and the wave speed (peak at the end of the record: "
+              f"the wave has not passed yet): {', '.join(r['excluded_from_fit'])}."]
+    f = r["fit"]
+    L += ["", "Power law p = C d^-n: " + (f"not available: {f['not_available']}" if _na(f) else
+          f"C = {f['C']:.4g} MPa·mm^n, n = {f['n']:.3f}, R² = {f['r2']:.3f} over "
+          f"{f['n_points']} probes") + " (paper: n = 0.798).",
+          "Wave speed from the peak arrivals: " + (f"not available: {w['not_available']}"
+          if _na(w) else f"{w['speed_m_s']:.0f} m/s (R² {w['r2']:.3f}, probes "
+          f"{', '.join(w['probes'])})") + " (paper 4270 m/s, measured 4535 m/s).", ""]
+    return L + _fig(doc, "fig16a_radial_stress") + _fig(doc, "fig16b_wave_speed") \
+        + _fig(doc, "fig17_peak_radial_stress")
+
+
+def _ppv(doc) -> list[str]:
+    p, pr, rad = doc["ppv"], doc["ppv_profile"], doc["ppv_radius"]
+    L = ["## PPV (Fig. 18)", ""]
+    if _na(p):
+        L.append(f"From the probes: not available: {p['not_available']}.")
+    else:
+        L.append("Peak |v_r| at the probes: " + ", ".join(
+            f"{q['name']} {q['ppv_m_s']:.3g} m/s at {q['d_mm']:.3g} mm" for q in p["points"]) + ".")
+        f = p["fit"]
+        L.append("Holmberg–Persson PPV = K d^-β: " + (f"not available: {f['not_available']}"
+                 if _na(f) else f"K = {f['C']:.4g} m/s·mm^β, β = {f['n']:.3f}, R² {f['r2']:.3f}")
+                 + " (the paper gives no value of β).")
+        if p.get("excluded_from_fit"):
+            L.append("Left out of the fit (peak at the end of the record): "
+                     + ", ".join(p["excluded_from_fit"]) + ".")
+    if not _na(pr):
+        L.append("The frame profile (ring means of the per-point max over saved frames) is a "
+                 "lower bound: frames sample every `output.every` steps.")
+    L.append("Distance within which PPV > 2.5 m/s: " + (
+        f"not available: {rad['not_available']}" if _na(rad) else
+        f"{rad['value_mm']:.3g} mm ({rad['source']})") + " (paper: about 20 mm; the paper's "
+        "'2500 m/s' read as 2500 mm/s).")
+    return L + [""] + _fig(doc, "fig18_ppv")
+
+
+def _paths(doc) -> list[str]:
+    ps = doc["pressure_stress"]
+    L = ["## Pressure–stress paths (Fig. 15)", ""]
+    if _na(ps):
+        return L + [f"Not available: {ps['not_available']}.", ""]
+    L += ["| probe | d (mm) | peak p (MPa) | peak s (MPa) | yields | p, s at yield (MPa) | "
+          "failed at (µs) |", "|---|---|---|---|---|---|---|"]
+    for q in ps["points"]:
+        at = "—" if not q["yielded"] else f"{q['p_at_yield_MPa']:.4g}, {q['s_at_yield_MPa']:.4g}"
+        L.append(f"| {q['name']} | {q['d_mm']:.3g} | {q['peak_p_MPa']:.4g} | "
+                 f"{q['peak_s_MPa']:.4g} | {_f(q['yielded'])} | {at} | {_f(q['failed_at_us'])} |")
+    L += ["", "Paper: P1 yields at p ≈ 200 MPa, P2 at s ≈ 150 MPa, P3 never reaches its "
+          "strength.", ""]
+    return L + _fig(doc, "fig15_pressure_stress")
+
+
+def _pressure(doc) -> list[str]:
+    g, w, ws = doc["gas_pressure"], doc["wall_pressure"], doc["wall_radial_stress"]
+    L = ["## Explosive and borehole-wall pressure (Fig. 7)", ""]
+    L.append("Peak explosive pressure over the saved frames: " + (
+        f"not available: {g['not_available']}" if _na(g) else
+        f"{g['peak_MPa']:.4g} MPa at {g['t_us']:.3g} µs") + " (paper: up to 1800 MPa; "
+        f"pressure_factor {_f(doc['model']['pressure_factor'])}).")
+    L.append("Rock wall layer (r < R_b + dx), peaks over the saved frames: normal stress on "
+             "the wall −σ_rr " + (f"not available ({ws['not_available']})" if _na(ws) else
+                                  f"{ws['peak_MPa']:.4g} MPa at {ws['t_us']:.3g} µs")
+             + "; mean pressure " + (f"not available ({w['not_available']})" if _na(w) else
+                                     f"{w['peak_MPa']:.4g} MPa at {w['t_us']:.3g} µs")
+             + " (FEM estimate of the wall pressure: 1600 MPa; the table uses −σ_rr when the "
+             "stress field was written).")
+    return L + [""] + _fig(doc, "fig07_explosive_pressure") + _fig(doc, "fig07_pressure_plane")
+
+
+def _energy(doc) -> list[str]:
+    e = doc["energy"]
+    L = ["## Energy in the rock (Fig. 20)", ""]
+    if _na(e):
+        return L + [f"Not available: {e['not_available']}.", ""]
+    tot = e["total_J"] or e["kinetic_J"]
+    L.append(f"Energy in the rock (Σ V (ρ|v|²/2 + W) over rock points): peak {max(tot):.4g} J, "
+             f"final {tot[-1]:.4g} J" + (f" — {e['note']}" if e.get("note") else "") + ".")
+    return L + [""] + _fig(doc, "fig20_rock_energy")

@@ -1,0 +1,74 @@
+"""The paper's and the experiment's numbers (DESIGN §8, paper §3.1–3.3) and the
+range each run value is judged against.
+
+Where the paper gives a range (the experiment's crack densities) that range is
+used as printed.  Where it gives one number ("about 130 MPa", "n = 0.798",
+"six major cracks") the band used is stated in ``band`` and printed in the
+report's table next to the verdict, so the judgement can be checked.  The bands
+are constants here: nothing in the analysis adapts them, or the measures, to a run.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Target:
+    key: str
+    label: str
+    unit: str
+    paper: str          # what the paper's simulation reports
+    experiment: str     # what the experiment reports
+    lo: float | None
+    hi: float | None
+    band: str           # how lo..hi was derived
+
+
+TARGETS = (
+    Target("wave_speed", "P-wave speed from peak arrivals A–G (Fig. 16b)", "m/s",
+           "4270", "4535", 4270 * 0.95, 4535 * 1.05,
+           "the paper's 4270 to the measured 4535, widened by 5 % each side"),
+    Target("peak_sigma_rr_A", "peak radial stress at A, 6.8 mm (Fig. 16a)", "MPa",
+           "≈130", "—", 130 * 0.8, 130 * 1.2, "130 ± 20 %"),
+    Target("peak_sigma_rr_G", "peak radial stress at G, 59.6 mm (Fig. 16a)", "MPa",
+           "< 20", "—", 0.0, 20.0, "below 20"),
+    Target("attenuation_n", "attenuation exponent n of p = C d^-n (Fig. 17)", "—",
+           "0.798", "agrees (Fig. 17)", 0.698, 0.898, "0.798 ± 0.1"),
+    Target("crack_density_zone1", "crack density, zone 1 (Fig. 12)", "mm/mm²",
+           "slightly below experiment", "0.30–0.46", 0.30, 0.46, "experiment's range"),
+    Target("crack_density_zone2", "crack density, zone 2 (Fig. 12)", "mm/mm²",
+           "slightly below experiment", "0.10–0.18", 0.10, 0.18, "experiment's range"),
+    Target("crack_density_zone3", "crack density, zone 3 (Fig. 12)", "mm/mm²",
+           "slightly below experiment", "0.05–0.13", 0.05, 0.13, "experiment's range"),
+    Target("major_radial_cracks", "major radial cracks reaching the boundary (Fig. 9)", "—",
+           "6", "several (Fig. 10)", 4, 8, "6 ± 2"),
+    Target("crushed_zone", "crushed zone extent beyond the wall (§3.2)", "borehole radii",
+           "≈1", "—", 0.5, 1.5, "1 ± 0.5 borehole radius"),
+    Target("ppv_radius_2p5", "distance within which PPV > 2.5 m/s (Fig. 18)", "mm",
+           "≈20 (text: '2500 m/s', read as mm/s)", "—", 15.0, 25.0, "20 ± 25 %"),
+    Target("peak_gas_pressure", "peak explosive pressure (Fig. 7)", "MPa",
+           "up to 1800", "—", 1800 * 0.75, 1800 * 1.25, "1800 ± 25 %"),
+    Target("peak_wall_pressure", "peak pressure at the borehole wall", "MPa",
+           "—", "1600 (FEM estimate)", 1600 * 0.75, 1600 * 1.25, "1600 ± 25 %"),
+    Target("P1_yields", "P1 (0.8 mm) reaches the JH2 strength (Fig. 15)", "yes/no",
+           "yes, at p ≈ 200 MPa", "—", 1, 1, "yes"),
+    Target("P2_yields", "P2 (1.6 mm) reaches the JH2 strength (Fig. 15)", "yes/no",
+           "yes, at s ≈ 150 MPa", "—", 1, 1, "yes"),
+    Target("P3_yields", "P3 (4.8 mm) reaches the JH2 strength (Fig. 15)", "yes/no",
+           "no", "—", 0, 0, "no"),
+)
+
+BY_KEY = {t.key: t for t in TARGETS}
+
+
+def verdict(key: str, value) -> str:
+    """'within', 'outside' or 'not available: <reason>' for a value (a number, a bool,
+    or a dict {'not_available': reason})."""
+    if isinstance(value, dict) and "not_available" in value:
+        return f"not available: {value['not_available']}"
+    if value is None:
+        return "not available"
+    t = BY_KEY[key]
+    v = float(value)
+    ok = (t.lo is None or v >= t.lo) and (t.hi is None or v <= t.hi)
+    return "within" if ok else "outside"
