@@ -23,7 +23,8 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 demo: install
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/demo --overwrite
 	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
-	@echo "demo: the fracture pattern is in $(CURDIR)/runs/demo/fracture.png (fields: runs/demo/run.h5, ParaView: runs/demo/run.xdmf)"
+	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/demo/run.h5 --out runs/demo/report
+	@echo "demo: the fracture pattern is in $(CURDIR)/runs/demo/fracture.png (validation report: runs/demo/report/report.md, fields: runs/demo/run.h5, ParaView: runs/demo/run.xdmf)"
 
 test: install
 	$(PY) -m pytest -q -ra tests
