@@ -88,7 +88,7 @@ def blast_slice(n: int, steps: int) -> dict:
 def blast_paper_slice(n: int, steps: int) -> dict:
     """The same slice at the paper's three resolutions: explosive 0.4 / 1.5 mm,
     copper 0.3 / 1.0 mm, rock 0.8 / 2.4 mm (dx / horizon), dual horizons with the
-    interface correction; rock out to n/2 mm (30 mm for n = 60), 10 mm thick."""
+    interface correction; rock out to n/1.5 mm (40 mm for n = 60), 10 mm thick."""
     d = blast_slice(n, steps)
     d["scene"]["name"] = "bench_blast_paper_dx"
     d["time"]["dt"] = 2e-8
@@ -98,7 +98,7 @@ def blast_paper_slice(n: int, steps: int) -> dict:
     tube.update(dx=3e-4, horizon_factor=1.0 / 0.3)
     tube["shape"].update(inner_radius=0.0026, radius=0.0032)
     rock.update(dx=8e-4)
-    rock["shape"].update(inner_radius=0.0032, radius=n / 2 * 1e-3)
+    rock["shape"].update(inner_radius=0.0032, radius=n / 1.5 * 1e-3)
     return d
 
 
