@@ -36,7 +36,10 @@ def _per_point(sim) -> dict:
     n = sim.points.n_owned
     c = sim.corr
     out = {"u": sim.u[:n], "v": sim.v[:n], "a": sim.a, "sigma": c.sigma, "R": c.R, "V": c.V,
-           "W": c.W, "spring": c.spring, "mode": sim.mode[:n]}
+           "W": c.W, "spring": c.spring, "mode": sim.mode[:n],
+           # F of the last step, from the shape tensors before that step's breakage:
+           # the next step's rotation increment needs it as it was, not recomputed
+           "F_old": c.F_old}
     for gi, g in enumerate(c.groups):
         for key, arr in g.state.items():
             full = np.zeros((n,) + arr.shape[1:], arr.dtype)
@@ -209,3 +212,4 @@ def restore(sim, path) -> None:
             sim.interface.retire(sim.mode)
     sim.initialize()
     sim.a[:] = data["a"]
+    c.F_old[:] = data["F_old"]
