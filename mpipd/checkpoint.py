@@ -112,6 +112,22 @@ def read_scene(path) -> tuple[str, list, int]:
         raise CheckpointError(f"{path}: cannot read checkpoint ({e})") from None
 
 
+class SignalFlag:
+    """Records SIGTERM/SIGUSR1 (what batch systems send before the wall-time
+    kill) instead of dying.  `mpipd run` installs it first thing, before the
+    model is built, so an early warning is never fatal; it stays installed to
+    the end, so a late one is harmless."""
+
+    def __init__(self):
+        import signal
+        self.seen = False
+        for sig in (signal.SIGTERM, signal.SIGUSR1):
+            signal.signal(sig, self._set)
+
+    def _set(self, signum, frame):
+        self.seen = True
+
+
 class Checkpointer:
     """Decides after each step whether to checkpoint, and whether to stop.
 
@@ -133,13 +149,19 @@ class Checkpointer:
         self.signalled = False
         self.written = None
 
-    def install_signals(self):
-        import signal
+    def install_signals(self, flag: "SignalFlag | None" = None):
+        """Stop at the next poll once SIGTERM/SIGUSR1 arrived — from now on, or,
+        given a :class:`SignalFlag` installed earlier, since then."""
+        self._flag = flag or SignalFlag()
 
-        def handler(signum, frame):
-            self.signalled = True
-        for sig in (signal.SIGTERM, signal.SIGUSR1):
-            signal.signal(sig, handler)
+    @property
+    def signalled(self) -> bool:
+        flag = getattr(self, "_flag", None)
+        return self._signalled or (flag is not None and flag.seen)
+
+    @signalled.setter
+    def signalled(self, value: bool):
+        self._signalled = bool(value)
 
     def write_final(self):
         """A last checkpoint for inspection (after a failure), beside the regular one."""

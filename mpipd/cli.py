@@ -117,10 +117,12 @@ def cmd_check(args) -> int:
 # ----------------------------------------------------------------------------- run
 
 def cmd_run(args) -> int:
+    from .checkpoint import SignalFlag
+    signals = SignalFlag()         # first: a batch system's early warning must not kill the run
     os.environ.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     from .parallel import abort_on_error, world
     team = world()
-    return abort_on_error(team, _run, args, team)
+    return abort_on_error(team, _run, args, team, signals)
 
 
 def _bad_input(team, exc) -> int:
@@ -129,7 +131,7 @@ def _bad_input(team, exc) -> int:
     return EXIT_BAD_INPUT
 
 
-def _run(args, team) -> int:
+def _run(args, team, signals=None) -> int:
     from . import checkpoint as ck
     from . import scene as sc
     from .decomp import DecompositionError
@@ -190,7 +192,7 @@ def _run(args, team) -> int:
     checkpointer = ck.Checkpointer(sim, out / "checkpoint.h5", text, overrides,
                                    every=scene.output.checkpoint_every,
                                    stop_after=args.stop_after)
-    checkpointer.install_signals()
+    checkpointer.install_signals(signals)
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
                        checkpointer=checkpointer)
