@@ -69,7 +69,8 @@ class Correspondence:
         self.V = np.array(eye)
         self.sigma = np.zeros((n, 6))           # unrotated Cauchy stress, Voigt
         self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
-        self.J = np.ones(n)
+        self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
+        self.J_end = np.ones(n)                 # det F at the end of the step (materials)
         self.W = np.zeros(n)                    # strain energy per reference volume
         self.gamma = np.zeros(n)                # sum_j omega V_j (Eq. 43)
         self.contact = bool(contact)
@@ -116,13 +117,13 @@ class Correspondence:
 
     def rotate(self, dt: float):
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
-                                self.spring, self.d, self.J)
+                                self.spring, self.d, self.J, self.J_end)
 
     def update_stress(self, dt: float, mode: np.ndarray):
         """Materials advance the stress; ``mode`` (failure flags) may be set by them."""
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
         for g in self.groups:
-            g.update(self.d, self.J, dt, self.sigma, mode)
+            g.update(self.d, self.J_end, dt, self.sigma, mode)
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
 
     def check_tension(self, mode: np.ndarray) -> int:

@@ -198,11 +198,18 @@ class Simulation:
 
     def check_finite(self):
         """Raise :class:`Unstable` on every rank if any owned u, v or stress is NaN/Inf,
+        or a point moves more than half its spacing in one step (|v| dt > dx/2: an
+        instability that the failure models keep finite by zeroing stresses),
         naming the first bad point (lowest gid) over all ranks."""
         n = self.points.n_owned
         bad = None
-        for name, arr in (("u", self.u[:n]), ("v", self.v[:n]), ("stress", self.corr.sigma)):
-            rows = np.flatnonzero(~np.all(np.isfinite(arr.reshape(n, -1)), axis=1))
+        runaway = np.einsum("ij,ij->i", self.v[:n], self.v[:n]) * self.dt ** 2 \
+            > (0.5 * self.points.dx[:n]) ** 2
+        for name, rows in (
+                ("u", np.flatnonzero(~np.all(np.isfinite(self.u[:n]), axis=1))),
+                ("v", np.flatnonzero(~np.all(np.isfinite(self.v[:n]), axis=1))),
+                ("stress", np.flatnonzero(~np.all(np.isfinite(self.corr.sigma), axis=1))),
+                ("speed |v| dt > dx/2", np.flatnonzero(runaway))):
             if len(rows):
                 i = rows[0]
                 cand = (int(self.points.gid[i]), name, tuple(self.points.x[i]))
@@ -210,7 +217,8 @@ class Simulation:
         found = [b for b in self.team.gather(bad) if b is not None]
         if found:
             gid, name, x = min(found)
-            raise Unstable(f"non-finite {name} at step {self.step_count} (t = {self.t:.4e} s), "
+            what = f"non-finite {name}" if name in ("u", "v", "stress") else name
+            raise Unstable(f"{what} at step {self.step_count} (t = {self.t:.4e} s), "
                            f"first at gid {gid}, x = ({x[0]:.4g}, {x[1]:.4g}, {x[2]:.4g}) m; "
                            "compare dt with `mpipd check`")
 
