@@ -85,6 +85,7 @@ def test_blow_up_is_stopped_with_its_first_bad_point(tmp_path):
                    "--set", "time.t_end=1e-3"], ranks=2, timeout=120)
     assert res.returncode == 3, res.stdout + res.stderr
     msg = [ln for ln in res.stderr.splitlines() if ln.startswith("mpipd: error")]
-    assert len(msg) == 1 and "non-finite" in msg[0] and "gid" in msg[0] and "x = (" in msg[0]
+    assert len(msg) == 1 and "gid" in msg[0] and "x = (" in msg[0]
+    assert "non-finite" in msg[0] or "|v| dt > dx" in msg[0]
     assert (out / "checkpoint_failed.h5").exists()
-    assert "non-finite" in (out / "run.log").read_text()
+    assert msg[0].split("error: ")[1] in (out / "run.log").read_text()
