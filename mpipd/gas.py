@@ -4,11 +4,15 @@ material.
 
 * Every rank holds every gas point (owned, or as a ghost: the halo replicates the
   gas, which moves far from its reference slab, and is a few per cent of a model).
-* Families are re-found every step in the current configuration with a cKDTree:
-  for each owned gas point, the gas and the ``interacts_with`` solids within the
-  gas horizon; for each owned such solid, the gas points whose horizon reaches
-  it.  No total-Lagrangian bond touches a gas point, and there are no gas-rock
-  bonds unless the scene lists the rock.
+* Families live in the current configuration: for each owned gas point, the gas
+  and the ``interacts_with`` solids within the gas horizon; for each owned such
+  solid, the gas points whose horizon reaches it.  No total-Lagrangian bond
+  touches a gas point, and there are no gas-rock bonds unless the scene lists
+  the rock.  They are searched with a cKDTree out to the horizon plus a skin
+  (Verlet list, SKIN x the gas horizon) and searched again only once some
+  eligible point has moved more than half the skin since: until then every pair
+  within the horizon is in the list.  The kernels keep only pairs inside the
+  horizon, in gid order, so the result is exactly that of a search every step.
 * Kernels: mpipd.kernels.ul.  Gas energy (per initial volume) is conserved with
   the work the gas does; it is reported as ``/energy/gas``.
 """
@@ -21,6 +25,9 @@ from scipy.spatial import cKDTree
 
 from .families import _csr_by_row
 from .kernels.ul import gas_gather, gas_update
+
+#: Verlet skin of the gas families, as a fraction of the gas horizon
+SKIN = 0.2
 
 
 class Gas:
@@ -52,23 +59,36 @@ class Gas:
         self.V_ratio = np.ones(n)
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
+        self.skin = SKIN * self.reach
+        self.y_built = None                      # eligible points' positions at the last search
+        self.searches = 0
         self.search_seconds = 0.0
         self.n_singular = 0
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
         self.y = None                            # current positions of the last update
 
     def search(self, y):
-        """Current-configuration families (positions y), each sorted by neighbour gid."""
+        """Current-configuration families (positions y), each sorted by neighbour gid:
+        every pair closer than the larger gas horizon plus the skin.  Skipped while
+        no eligible point has moved half the skin since the last search."""
         t0 = time.perf_counter()
         p = self.points
         el = self.eligible
         n = p.n_owned
+        if self.y_built is not None:
+            d = y[el] - self.y_built
+            moved = float(np.einsum("ij,ij->i", d, d).max()) if len(el) else 0.0
+            if moved < (0.5 * self.skin) ** 2:
+                self.search_seconds += time.perf_counter() - t0
+                return
+        self.y_built = y[el]
+        self.searches += 1
         if len(self.rows) and len(el):
-            m = cKDTree(y[self.rows]).sparse_distance_matrix(cKDTree(y[el]), self.reach,
-                                                             output_type="ndarray")
+            m = cKDTree(y[self.rows]).sparse_distance_matrix(
+                cKDTree(y[el]), self.reach + self.skin, output_type="ndarray")
             i, j = self.rows[m["i"]], el[m["j"]]
             h = self.gas_horizon
-            keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]))
+            keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
             counts, self.nbr = _csr_by_row(i[keep], j[keep], p.gid, n)
             self.offsets[1:] = np.cumsum(counts)
         else:
