@@ -80,6 +80,14 @@ class Timer:
         return self.team.max(time.perf_counter() - self.t0)
 
 
+def timed_simulation(team, scene):
+    """Start the clock (set-up counts as run time) and build the Simulation."""
+    from mpipd.solver import Simulation
+    tm = Timer(team)
+    tm.start()
+    return tm, Simulation(scene, team)
+
+
 # ----------------------------------------------------------------------------- wave
 
 class Wave:
@@ -120,11 +128,8 @@ class Wave:
         sim.v[: sim.points.n_owned, 1:] = 0.0
 
     def run(self, team, dx, steps=None):
-        from mpipd.solver import Simulation
         scene = self.scene(dx, steps)
-        tm = Timer(team)
-        tm.start()
-        sim = Simulation(scene, team)
+        tm, sim = timed_simulation(team, scene)
         n = sim.points.n_owned
         x = sim.points.x[:n, 0]
         n_planes = int(round(self.LENGTH / dx))
@@ -208,11 +213,8 @@ class Lame:
         return A - B / r ** 2, A + B / r ** 2
 
     def run(self, team, dx, steps=None):
-        from mpipd.solver import Simulation
         scene = self.scene(dx, steps)
-        tm = Timer(team)
-        tm.start()
-        sim = Simulation(scene, team)
+        tm, sim = timed_simulation(team, scene)
         n = sim.points.n_owned
         sim.damp = np.full(n, self.DAMPING)          # harness: global mass-proportional damping
         ke_peak = 0.0
@@ -278,11 +280,8 @@ class Energy:
         return build_scene(d)
 
     def run(self, team, dx, steps=None):
-        from mpipd.solver import Simulation
         scene = self.scene(dx, steps)
-        tm = Timer(team)
-        tm.start()
-        sim = Simulation(scene, team)
+        tm, sim = timed_simulation(team, scene)
         E, S = [sim.energies().total], [0]
         for _ in range(scene.time.n_steps):
             sim.step()
@@ -509,14 +508,11 @@ class Detonation:
         return res
 
     def run(self, team, res, steps=None):
-        from mpipd.solver import Simulation
         dx = self.dx_of(res)
         scene = self.scene(dx, steps, self.dt_fraction(res))
         c = JWL_TABLE2
         p_half = 0.5 * float(jwl_p(1.0, c["e0"]))
-        tm = Timer(team)
-        tm.start()
-        sim = Simulation(scene, team)
+        tm, sim = timed_simulation(team, scene)
         gas = sim.gas
         gi = gas.gas_idx
         x = sim.points.x[gi]

@@ -146,6 +146,7 @@ class Checkpointer:
         self.every = every
         self.stop_after = stop_after
         self.poll = poll
+        self._flag = None
         self.signalled = False
         self.written = None
 
@@ -156,8 +157,7 @@ class Checkpointer:
 
     @property
     def signalled(self) -> bool:
-        flag = getattr(self, "_flag", None)
-        return self._signalled or (flag is not None and flag.seen)
+        return self._signalled or (self._flag is not None and self._flag.seen)
 
     @signalled.setter
     def signalled(self, value: bool):

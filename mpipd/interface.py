@@ -70,10 +70,8 @@ class InterfaceCorrection:
         reach = self._reach(p.horizon, fam, cand)
         inside = balls_inside(tl_parts, p.x[cand], 2.0 * reach)
         self.idx = cand[inside]
-        self.n_surface = int(np.count_nonzero(~inside))     # affected, but near a free surface
         K = np.linalg.inv(corr.Kinv[self.idx])
-        self.q = np.ascontiguousarray(np.einsum("nij,nj->ni", K, g[inside]))
-        self.g = np.ascontiguousarray(g[inside])
+        self.q = np.ascontiguousarray(np.einsum("nij,nj->ni", K, g[inside]))   # K_i g_i
         self.active = np.ones(len(self.idx), dtype=np.uint8)
         self.families = fam
 

@@ -35,8 +35,6 @@ def total_points(text):
 
 
 def test_blast_paper_has_the_papers_size():
-    if "blast_paper" not in sc.builtin_scenes():
-        pytest.skip("the built-in scene blast_paper does not exist yet (issue 5, being added)")
     res = run_cli(["check", "blast_paper", "--ranks", "24"], timeout=600)
     assert res.returncode == 0, res.stderr
     n = total_points(res.stdout)
