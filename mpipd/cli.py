@@ -184,6 +184,11 @@ def _run(args, team, signals=None) -> int:
     if sim.n_spring_global:
         log(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
             "(shape tensor not invertible)")
+    if sim.interface is not None:
+        full, planar, left = (team.sum(c) for c in sim.interface.counts)
+        log(f"mpipd: interface correction: {full} point(s) in full, {planar} in the x-y "
+            f"plane (near a z face); {left} keep their ghost force (an interface within "
+            "two horizons of an x-y free surface, README)")
     team.barrier()
     shown = text + ("\n# overrides (--set)\n" + "".join(f"# {o}\n" for o in overrides)
                     if overrides else "")

@@ -262,3 +262,55 @@ def balls_inside(parts, x: np.ndarray, radius: np.ndarray, n_dir: int = 96,
                        & p.shape.contains_xy(y[:, 0], y[:, 1], -tol))
             inside &= ok
     return inside
+
+
+def z_faces(part) -> tuple[float, float]:
+    """The z faces of a part's lattice (its first and last level -/+ dx/2), which
+    may differ from the shape's ``z`` when the thickness is not a multiple of dx."""
+    z = part.shape.z_levels(part.dx)
+    return float(z[0] - 0.5 * part.dx), float(z[-1] + 0.5 * part.dx)
+
+
+def prisms_inside(parts, x: np.ndarray, radius: np.ndarray, n_dir: int = 64,
+                  rings=(0.0, 0.25, 0.5, 0.75, 1.0)) -> np.ndarray:
+    """True where, within ``radius`` of ``x``, the union of ``parts`` is a prism
+    along z cut by flat z faces: the disk of that radius in the x-y plane lies
+    inside the cross-sections of the parts at x's level, and every part reaching
+    into the ball ends at the same lattice z faces there (clipped to the ball).
+
+    There the body near x is its cross-section extruded, so a single-resolution
+    lattice is mirror-symmetric in x and y about x — the test of
+    :class:`mpipd.interface.InterfaceCorrection` for keeping only a z face's
+    traction.  Disk samples: the centre and ``n_dir`` directions on each ring."""
+    out = np.ones(len(x), dtype=bool)
+    if not len(x):
+        return out
+    tol = 1e-9 * min(p.dx for p in parts)
+    ang = 2.0 * np.pi * (np.arange(n_dir) + 0.5) / n_dir
+    dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    samples = [(x[:, 0], x[:, 1])] + [(x[:, 0] + f * radius * c, x[:, 1] + f * radius * s)
+                                      for f in rings if f > 0 for c, s in dirs]
+    zlo, zhi = x[:, 2] - radius, x[:, 2] + radius
+    faces = [z_faces(p) for p in parts]
+    covers = [(x[:, 2] > a - tol) & (x[:, 2] < b + tol) for a, b in faces]
+    near = [np.zeros(len(x), dtype=bool) for _ in parts]
+    for sx, sy in samples:
+        ok = np.zeros(len(x), dtype=bool)
+        for k, p in enumerate(parts):
+            hit = p.shape.contains_xy(sx, sy, -tol)
+            ok |= covers[k] & hit
+            near[k] |= hit
+        out &= ok
+    # every part met within the ball ends at the same (clipped) z faces
+    lo_min = np.full(len(x), np.inf)
+    lo_max = np.full(len(x), -np.inf)
+    hi_min, hi_max = lo_min.copy(), lo_max.copy()
+    for k, (a, b) in enumerate(faces):
+        m = near[k] & (a < zhi) & (b > zlo)
+        lo = np.maximum(a, zlo)
+        hi = np.minimum(b, zhi)
+        lo_min[m] = np.minimum(lo_min[m], lo[m])
+        lo_max[m] = np.maximum(lo_max[m], lo[m])
+        hi_min[m] = np.minimum(hi_min[m], hi[m])
+        hi_max[m] = np.maximum(hi_max[m], hi[m])
+    return out & (lo_max - lo_min < tol) & (hi_max - hi_min < tol)

@@ -38,11 +38,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import balls_inside
+from .geometry import balls_inside, prisms_inside
 from .kernels import interface as kern
 
 #: |g_i| dx_i above this is a ghost force (round-off in a uniform lattice is ~1e-14)
-G_TOL = 1e-9
+G_TOL = 1e-12
 
 
 def needed(scene, tl_parts) -> bool:
@@ -61,19 +61,39 @@ class InterfaceCorrection:
         kinv[:n, 9] = (corr.spring != 0).astype(float)
         kinv[n:, 9] = 1.0
         halo.exchange(kinv)
-        cand = np.flatnonzero(tl[:n] & (corr.spring == 0)).astype(np.int64)
+        near = self._near_interface(p, fam, halo)
+        cand = np.flatnonzero(tl[:n] & (corr.spring == 0) & near).astype(np.int64)
         g = np.zeros((len(cand), 3))
         kern.interface_vectors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
                                kinv, cand, g)
         sel = np.linalg.norm(g, axis=1) * p.dx[cand] > G_TOL
         cand, g = cand[sel], g[sel]
         reach = self._reach(p.horizon, fam, cand)
-        inside = balls_inside(tl_parts, p.x[cand], 2.0 * reach)
-        self.idx = cand[inside]
+        full = balls_inside(tl_parts, p.x[cand], 2.0 * reach)
+        planar = ~full & prisms_inside(tl_parts, p.x[cand], 2.0 * reach)
+        g[planar, 2] = 0.0                     # a z face's traction stays
+        keep = (full | planar) & (np.linalg.norm(g, axis=1) * p.dx[cand] > G_TOL)
+        self.idx = cand[keep]
         K = np.linalg.inv(corr.Kinv[self.idx])
-        self.q = np.ascontiguousarray(np.einsum("nij,nj->ni", K, g[inside]))   # K_i g_i
+        self.q = np.ascontiguousarray(np.einsum("nij,nj->ni", K, g[keep]))   # K_i g_i
+        #: owned points corrected in full, in the plane only, and left with their ghost
+        #: force (an interface within two reaches of an x-y free surface)
+        self.counts = (int((keep & full).sum()), int((keep & planar).sum()),
+                       int((~(full | planar)).sum()))
         self.active = np.ones(len(self.idx), dtype=np.uint8)
         self.families = fam
+
+    @staticmethod
+    def _near_interface(p, fam, halo) -> np.ndarray:
+        """Owned points whose g_i can feel a change of dx or horizon: a family
+        member of another resolution, or a family member that has one."""
+        n = p.n_owned
+        mixed = np.zeros(p.n_local, dtype=np.uint8)
+        kern.mixed_families(p.dx, p.horizon, fam.offsets, fam.nbr, n, mixed)
+        halo.exchange(mixed)
+        near = np.zeros(n, dtype=np.uint8)
+        kern.spread(mixed, fam.offsets, fam.nbr, n, near)
+        return near.astype(bool)
 
     @staticmethod
     def _reach(horizon, fam, idx) -> np.ndarray:

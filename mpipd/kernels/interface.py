@@ -98,3 +98,28 @@ def family_reach(horizon, offsets, nbr, idx, out):
         for b in range(offsets[i], offsets[i + 1]):
             m = max(m, horizon[nbr[b]])
         out[p] = m
+
+
+@numba.njit(cache=True)
+def mixed_families(dx, horizon, offsets, nbr, n_owned, out):
+    """out[i] = 1 for owned i whose family holds a point of another dx or horizon."""
+    for i in range(n_owned):
+        hit = 0
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            if dx[j] != dx[i] or horizon[j] != horizon[i]:
+                hit = 1
+                break
+        out[i] = hit
+
+
+@numba.njit(cache=True)
+def spread(flag, offsets, nbr, n_owned, out):
+    """out[i] = 1 for owned i flagged itself or with a flagged family member."""
+    for i in range(n_owned):
+        hit = flag[i]
+        b = offsets[i]
+        while hit == 0 and b < offsets[i + 1]:
+            hit = flag[nbr[b]]
+            b += 1
+        out[i] = hit
