@@ -13,12 +13,23 @@ two horizons of a change of spacing or horizon (a coarse/fine interface, the
 zones of a graded part).  That is a ghost force: a uniform strain across the
 interface is not in equilibrium.
 
-The correction (this module) subtracts P_i g_i at every point where g_i is
-not zero *and* whose ball of radius twice its reach lies inside the
-total-Lagrangian body — there, and only there, the uniform-stress force is
-pure artefact.  Near a free surface (and at the copper wall facing the gas)
-g_i also carries the surface's traction term, which must stay, so those
-points are left alone.  At a corrected point the force becomes
+The correction (this module) acts on points whose g_i can feel a change of
+resolution (a family member of another dx or horizon, or one that has one):
+
+* in full where the ball of twice the point's reach lies inside the
+  total-Lagrangian body — there the uniform-stress force is pure artefact;
+* in the x-y plane where that ball leaves the body only through z faces shared
+  by every part near the point (the body is a prism there: thin slices, the
+  faces of a specimen).  A flat z face's own traction in a single-resolution
+  lattice is along z (mirror symmetry in x and y about the point), so only the
+  x and y components of g_i are ghost force; the z component stays;
+* not at all where an x-y free surface lies inside the ball (the paper's tube
+  wall, thinner than the rock's horizon): there the surface's traction and the
+  interface's ghost force share the same points and cannot be told apart — the
+  uncorrected forces already carry the face's exact traction and centroid
+  (tested); the scene can move the step away instead (``Part.band``).
+
+At a point corrected in full the force becomes
 
     f_i = sum_j omega_j V_j (P_j - P_i) K_j^-1 xi_ij   (+ hourglass, contact, viscosity)
 

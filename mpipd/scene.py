@@ -98,6 +98,26 @@ class Grade:
 
 
 @dataclass(frozen=True)
+class Band:
+    """An inner ring of an annulus part at a resolution of its own, ``width`` wide.
+
+    Given the neighbour's ``dx`` and ``horizon_factor`` (the paper's copper tube:
+    0.3 mm, 3.3333333), the tube and the band share one lattice and one horizon,
+    so their interface is seamless, and the step to the part's own dx moves
+    ``width`` out — far enough from the bore (two reaches of the coarse side plus
+    the coarse horizon) and it is corrected in full.  Named ``<part>.band``."""
+    dx: float
+    width: float
+    horizon_factor: float = 3.0
+
+    def check(self, path):
+        positive(self, path, "dx")
+        positive(self, path, "width")
+        if not self.horizon_factor >= 1.0:
+            fail(join(path, "horizon_factor"), f"must be at least 1 (got {self.horizon_factor})")
+
+
+@dataclass(frozen=True)
 class Part:
     name: str
     material: str
@@ -105,6 +125,7 @@ class Part:
     shape: Any = tagged(SHAPES)
     horizon_factor: float = 3.0
     grade: Grade | None = None
+    band: Band | None = None
 
     def check(self, path):
         positive(self, path, "dx")
@@ -113,9 +134,26 @@ class Part:
                  f"horizon must be at least dx (factor >= 1, got {self.horizon_factor})")
         if self.grade is not None and not hasattr(self.shape, "radius"):
             fail(join(path, "grade"), "grading needs a cylinder or annulus shape")
+        if self.band is not None:
+            r0 = getattr(self.shape, "inner_radius", None)
+            if r0 is None:
+                fail(join(path, "band"), "an inner band needs an annulus shape")
+            if not self.band.width < self.shape.radius - r0:
+                fail(join(join(path, "band"), "width"),
+                     f"must be less than the annulus's width {self.shape.radius - r0:g}")
 
     def zones(self) -> list["Part"]:
-        """The part itself, or its graded rings as separate ungraded parts."""
+        """The part itself, or its inner band and graded rings as separate plain parts."""
+        if self.band is not None:
+            b, sh = self.band, self.shape
+            edge = sh.inner_radius + b.width
+            ring = SHAPES.get("annulus")(center=sh.center, radius=edge, z=sh.z,
+                                         inner_radius=sh.inner_radius)
+            rest = SHAPES.get("annulus")(center=sh.center, radius=sh.radius, z=sh.z,
+                                         inner_radius=edge)
+            inner = replace(self, name=f"{self.name}.band", dx=b.dx,
+                            horizon_factor=b.horizon_factor, shape=ring, grade=None, band=None)
+            return [inner] + replace(self, shape=rest, band=None).zones()
         g = self.grade
         if g is None:
             return [self]
@@ -132,7 +170,7 @@ class Part:
                 ring = SHAPES.get("cylinder")(center=sh.center, radius=float(edges[k + 1]),
                                               z=sh.z)
             out.append(replace(self, name=f"{self.name}.{k}", dx=float(dx), shape=ring,
-                               grade=None))
+                               grade=None, band=None))
         return out
 
     @property
@@ -200,7 +238,7 @@ class Scene:
 
     def __post_init__(self):
         # a graded part becomes its rings (Grade): everything downstream sees plain parts
-        if any(p.grade is not None for p in self.parts):
+        if any(p.grade is not None or p.band is not None for p in self.parts):
             object.__setattr__(self, "parts", tuple(z for p in self.parts for z in p.zones()))
 
     def check(self, path):

@@ -260,3 +260,58 @@ def test_interface_inside_a_free_surfaces_horizon_keeps_the_exact_traction(team)
     filled, _ = layered_slab(0.6e-3 + 0.0054, correction=False)
     share, _ = traction_near_face(Simulation(filled, team), face, upto=face)
     assert share > 0.1
+
+
+def tube_in_rock_plate(band=True):
+    """The paper's tube (copper 0.3/1.0 mm, bore 2.6 mm, wall 0.6 mm) in rock
+    0.8/2.4 mm out to 20 mm, a plate 2.4 mm thick; with the rock's inner band at
+    the tube's resolution out to r = 10 mm, or without."""
+    z = [0.0, 0.0024]
+    rock = {"name": "rock", "material": "rock", "dx": 0.8e-3,
+            "shape": {"kind": "annulus", "center": [0.0, 0.0], "inner_radius": 0.0032,
+                      "radius": 0.020, "z": z}}
+    if band:
+        rock["band"] = {"dx": 0.3e-3, "horizon_factor": 1.0 / 0.3, "width": 0.0068}
+    parts = [{"name": "tube", "material": "copper", "dx": 0.3e-3, "horizon_factor": 1.0 / 0.3,
+              "shape": {"kind": "annulus", "center": [0.0, 0.0], "inner_radius": 0.0026,
+                        "radius": 0.0032, "z": z}}, rock]
+    d = scene_dict(None, parts=parts)
+    d["materials"] = {"rock": granite(),
+                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
+    return make_scene(d)
+
+
+def test_inner_band_makes_the_tube_interface_seamless(team):
+    """With the rock's inner band at the tube's dx and horizon, tube and band share
+    one lattice (no interface at all), and the step to 0.8 mm lies far enough out
+    to be corrected: no point keeps a ghost force.  Plane stress then gives no
+    force beyond two copper horizons of the bore (its own traction) and inside
+    two rock reaches of the outer face.  Without the band, points there do."""
+    scene = tube_in_rock_plate()
+    assert [q.name for q in scene.parts] == ["tube", "rock.band", "rock"]
+    assert scene.parts[1].shape.radius == scene.parts[2].shape.inner_radius == 0.010
+    sim = Simulation(scene, team)
+    assert sim.interface.counts[2] == 0 and sim.interface.counts[1] > 100
+    n = sim.points.n_owned
+    r = np.hypot(sim.points.x[:n, 0], sim.points.x[:n, 1])
+    between = (r > 0.0026 + 2.0e-3 * 1.01) & (r < 0.020 - 4.8e-3 * 1.01)
+    assert plane_stress_forces(sim)[between].max() < 1e-10
+    bare = Simulation(tube_in_rock_plate(band=False), team)
+    assert bare.interface.counts[2] > 100
+    r = np.hypot(bare.points.x[:, 0], bare.points.x[:, 1])[:bare.points.n_owned]
+    between = (r > 0.0026 + 2.0e-3 * 1.01) & (r < 0.020 - 4.8e-3 * 1.01)
+    assert plane_stress_forces(bare)[between].max() > 1e-2
+
+
+def test_band_needs_an_annulus_and_fits_in_it():
+    from mpipd.schema import SceneError
+    d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [0.006, 0.006, 0.006]})
+    d["parts"][0]["band"] = {"dx": 3e-4, "width": 1e-3}
+    with pytest.raises(SceneError, match="band"):
+        make_scene(d)
+    shape = {"kind": "annulus", "center": [0.0, 0.0], "inner_radius": 0.003, "radius": 0.006,
+             "z": [0.0, 0.003]}
+    d = scene_dict(shape)
+    d["parts"][0]["band"] = {"dx": 3e-4, "width": 0.004}
+    with pytest.raises(SceneError, match="band.width"):
+        make_scene(d)

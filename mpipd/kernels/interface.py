@@ -12,7 +12,6 @@ points, with A_i = P_i K_i^-1 = B_i + h_i F_i (the force data) and q_i = K_i g_i
 import math
 
 import numba
-import numpy as np
 
 from .nosb import influence
 
