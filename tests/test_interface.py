@@ -19,15 +19,21 @@ H = np.array([[1e-3, 2e-4, -3e-4], [5e-4, -2e-3, 1e-4], [-1e-4, 3e-4, 1.5e-3]])
 L = 0.0144                                   # 18 x 0.8 mm = 48 x 0.3 mm
 
 
+def rock_and_copper(parts, correction):
+    """Scene dict of ``parts`` made of granite ("rock") and elastic copper ("copper")."""
+    d = scene_dict(None, parts=parts)
+    d["materials"] = {"rock": granite(),
+                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
+    d["solver"]["interface_correction"] = correction
+    return d
+
+
 def rock_beside_copper(correction=True):
     parts = [{"name": "rock", "material": "rock", "dx": 0.8e-3,
               "shape": {"kind": "box", "lo": [0, 0, 0], "hi": [0.008, L, L]}},
              {"name": "tube", "material": "copper", "dx": 0.3e-3, "horizon_factor": 1.0 / 0.3,
               "shape": {"kind": "box", "lo": [0.008, 0, 0], "hi": [0.0116, L, L]}}]
-    d = scene_dict(None, parts=parts)
-    d["materials"] = {"rock": granite(),
-                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
-    d["solver"]["interface_correction"] = correction
+    d = rock_and_copper(parts, correction)
     return make_scene(d)
 
 
@@ -41,21 +47,28 @@ def graded_ring(correction=True):
     return make_scene(d)
 
 
-def uniform_state_forces(sim):
-    """Affine u = H X, uniform Cauchy stress: returns (F error, force/scale, deep mask)."""
+def affine_state_forces(sim, Hmat, sigma):
+    """Affine u = Hmat X, uniform Cauchy stress ``sigma`` (Voigt), no rotation:
+    returns (F error, |force| per point over a stress over one spacing)."""
     p = sim.points
     n = p.n_owned
-    sim.u[:] = p.x @ H.T
+    sim.u[:] = p.x @ Hmat.T
     sim.v[:] = 0.0
     sim.corr.deform(sim.u, sim.v)
-    ferr = np.abs(sim.corr.F - (np.eye(3) + H)).max()
+    ferr = np.abs(sim.corr.F - (np.eye(3) + Hmat)).max()
     sim.corr.R[:] = np.eye(3)
-    sim.corr.sigma[:] = SIGMA
+    sim.corr.sigma[:] = sigma
     sim.compute_forces()
+    return ferr, np.abs(sim.f).max(axis=1) / (np.abs(sigma).max() / p.dx[:n])
+
+
+def uniform_state_forces(sim):
+    """The general uniform state: (F error, force/scale, deep mask)."""
+    ferr, f = affine_state_forces(sim, H, SIGMA)
+    n = sim.points.n_owned
     reach = 2.0 * max(q.horizon for q in sim.scene.parts)
-    deep = balls_inside(sim.scene.parts, p.x[:n], np.full(n, reach))
-    scale = np.abs(SIGMA).max() / p.dx[:n]          # a stress over one spacing
-    return ferr, np.abs(sim.f).max(axis=1) / scale, deep
+    deep = balls_inside(sim.scene.parts, sim.points.x[:n], np.full(n, reach))
+    return ferr, f, deep
 
 
 @pytest.mark.parametrize("build", [rock_beside_copper, graded_ring])
@@ -90,10 +103,7 @@ def thin_plate_beside_copper(correction=True):
               "shape": {"kind": "box", "lo": [0, 0, 0], "hi": [0.008, L, 0.0024]}},
              {"name": "tube", "material": "copper", "dx": 0.3e-3, "horizon_factor": 1.0 / 0.3,
               "shape": {"kind": "box", "lo": [0.008, 0, 0], "hi": [0.0152, L, 0.0024]}}]
-    d = scene_dict(None, parts=parts)
-    d["materials"] = {"rock": granite(),
-                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
-    d["solver"]["interface_correction"] = correction
+    d = rock_and_copper(parts, correction)
     return make_scene(d), lambda x: ((x[:, 0] > 0.0048) & (x[:, 0] < 0.0152 - 0.0048)
                                      & (x[:, 1] > 0.0048) & (x[:, 1] < L - 0.0048))
 
@@ -116,16 +126,9 @@ def thin_graded_ring(correction=True):
 
 
 def plane_stress_forces(sim):
-    p = sim.points
-    n = p.n_owned
-    sim.u[:] = p.x @ H_PLANE.T
-    sim.v[:] = 0.0
-    sim.corr.deform(sim.u, sim.v)
-    assert np.abs(sim.corr.F - (np.eye(3) + H_PLANE)).max() < 1e-13
-    sim.corr.R[:] = np.eye(3)
-    sim.corr.sigma[:] = SIGMA_PLANE
-    sim.compute_forces()
-    return np.abs(sim.f).max(axis=1) / (np.abs(SIGMA_PLANE).max() / p.dx[:n])
+    ferr, f = affine_state_forces(sim, H_PLANE, SIGMA_PLANE)
+    assert ferr < 1e-13
+    return f
 
 
 @pytest.mark.parametrize("build", [thin_plate_beside_copper, thin_graded_ring])
@@ -207,10 +210,7 @@ def layered_slab(t_copper, correction=True):
               "shape": {"kind": "box", "lo": [0, 0, 0], "hi": [xi, L, L]}},
              {"name": "tube", "material": "copper", "dx": 0.3e-3, "horizon_factor": 1.0 / 0.3,
               "shape": {"kind": "box", "lo": [xi, 0, 0], "hi": [xi + t_copper, L, L]}}]
-    d = scene_dict(None, parts=parts)
-    d["materials"] = {"rock": granite(),
-                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
-    d["solver"]["interface_correction"] = correction
+    d = rock_and_copper(parts, correction)
     return make_scene(d), xi + t_copper
 
 
@@ -219,14 +219,9 @@ def traction_near_face(sim, face, upto=np.inf):
     4.8 mm < x < ``upto`` (clear of the rock's left face) in a central y-z window
     4.8 mm square (6 rock and 16 copper cells wide), and its first moment about
     ``face``."""
+    affine_state_forces(sim, np.zeros((3, 3)), np.array([1e6, 0, 0, 0, 0, 0]))
     p = sim.points
     n = p.n_owned
-    sim.u[:] = 0.0
-    sim.v[:] = 0.0
-    sim.corr.deform(sim.u, sim.v)
-    sim.corr.R[:] = np.eye(3)
-    sim.corr.sigma[:] = [1e6, 0, 0, 0, 0, 0]
-    sim.compute_forces()
     x = p.x[:n]
     w = ((x[:, 0] > 0.0048) & (x[:, 0] < upto) & (x[:, 1] > 0.0048) & (x[:, 1] < 0.0096)
          & (x[:, 2] > 0.0048) & (x[:, 2] < 0.0096))
@@ -275,10 +270,14 @@ def tube_in_rock_plate(band=True):
     parts = [{"name": "tube", "material": "copper", "dx": 0.3e-3, "horizon_factor": 1.0 / 0.3,
               "shape": {"kind": "annulus", "center": [0.0, 0.0], "inner_radius": 0.0026,
                         "radius": 0.0032, "z": z}}, rock]
-    d = scene_dict(None, parts=parts)
-    d["materials"] = {"rock": granite(),
-                      "copper": granite(bulk_modulus=130e9, shear_modulus=45e9, density=8960.0)}
-    return make_scene(d)
+    return make_scene(rock_and_copper(parts, True))
+
+
+def between_bore_and_rim(sim):
+    """Points beyond two copper horizons of the bore and two rock reaches of the rim."""
+    x = sim.points.x[:sim.points.n_owned]
+    r = np.hypot(x[:, 0], x[:, 1])
+    return (r > 0.0026 + 2.0e-3 * 1.01) & (r < 0.020 - 4.8e-3 * 1.01)
 
 
 def test_inner_band_makes_the_tube_interface_seamless(team):
@@ -292,15 +291,10 @@ def test_inner_band_makes_the_tube_interface_seamless(team):
     assert scene.parts[1].shape.radius == scene.parts[2].shape.inner_radius == 0.010
     sim = Simulation(scene, team)
     assert sim.interface.counts[2] == 0 and sim.interface.counts[1] > 100
-    n = sim.points.n_owned
-    r = np.hypot(sim.points.x[:n, 0], sim.points.x[:n, 1])
-    between = (r > 0.0026 + 2.0e-3 * 1.01) & (r < 0.020 - 4.8e-3 * 1.01)
-    assert plane_stress_forces(sim)[between].max() < 1e-10
+    assert plane_stress_forces(sim)[between_bore_and_rim(sim)].max() < 1e-10
     bare = Simulation(tube_in_rock_plate(band=False), team)
     assert bare.interface.counts[2] > 100
-    r = np.hypot(bare.points.x[:, 0], bare.points.x[:, 1])[:bare.points.n_owned]
-    between = (r > 0.0026 + 2.0e-3 * 1.01) & (r < 0.020 - 4.8e-3 * 1.01)
-    assert plane_stress_forces(bare)[between].max() > 1e-2
+    assert plane_stress_forces(bare)[between_bore_and_rim(bare)].max() > 1e-2
 
 
 def test_band_needs_an_annulus_and_fits_in_it():
