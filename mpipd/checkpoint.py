@@ -37,9 +37,22 @@ def _per_point(sim) -> dict:
     c = sim.corr
     out = {"u": sim.u[:n], "v": sim.v[:n], "a": sim.a, "sigma": c.sigma, "R": c.R, "V": c.V,
            "W": c.W, "spring": c.spring, "mode": sim.mode[:n],
-           # F of the last step, from the shape tensors before that step's breakage:
-           # the next step's rotation increment needs it as it was, not recomputed
-           "F_old": c.F_old}
+           # F of the last step, over the families after that step's breakage (the
+           # next rotation increment needs it as it was, not recomputed), and the
+           # volume factor that keeps J continuous across those rebuilds
+           "F_old": c.F_old, "Jfac": c.Jfac}
+    led = sim.ledger                              # the ledger's per-point memory
+    if len(led.edamp):
+        out["ledger_edamp"] = led.edamp
+    if len(led.fv_old):
+        out["ledger_fv_old"] = led.fv_old
+    if sim.interface is not None:
+        fc = np.zeros((n, 3))
+        fc[sim.interface.idx] = led.fc_old
+        out["ledger_fc_old"] = fc
+    for key, arr in sim.peaks.arrays.items():
+        if len(arr):
+            out[key] = arr
     for gi, g in enumerate(c.groups):
         for key, arr in g.state.items():
             full = np.zeros((n,) + arr.shape[1:], arr.dtype)
@@ -49,6 +62,8 @@ def _per_point(sim) -> dict:
         gas = sim.gas
         out["gas_V"] = gas.gd[:n, 6]
         out["gas_p"] = gas.gd[:n, 7]
+        out["gas_A"] = gas.gd[:n, :6]             # the last force (its work ends next step)
+        out["gas_Vw"] = gas.V_w[:n]               # the last step's pair weights
         e = np.zeros(n)
         e[gas.gas_idx] = gas.e
         out["gas_e"] = e
@@ -84,6 +99,13 @@ def write(sim, path, scene_text: str, overrides=()) -> Path:
         a["n_points"] = N
         a["ranks"] = team.size
         a["external_work"] = team.sum(sim.external_work)
+        led = sim.ledger
+        for key, v in (("ledger_viscous_work", led.viscous_work),
+                       ("ledger_interface_work", led.interface_work),
+                       ("ledger_jumps", led.jumps),
+                       ("ledger_contact_jumps", led.contact_jumps)):
+            a[key] = team.sum(v)
+        a["ledger_initial"] = led.initial
         a["bonds_broken"] = sim.bonds_broken()
         for name, arr in _per_point(sim).items():
             d = f.create_dataset(f"points/{name}", (N,) + arr.shape[1:], arr.dtype)
@@ -199,6 +221,9 @@ def restore(sim, path) -> None:
         mine = broken[lo:hi] if hi > lo else np.empty((0, 2), np.int64)
         step, t = int(f.attrs["step"]), float(f.attrs["t"])
         work = float(f.attrs["external_work"])
+        ledger = {k: float(f.attrs[k]) for k in ("ledger_viscous_work", "ledger_interface_work",
+                                                 "ledger_jumps", "ledger_contact_jumps",
+                                                 "ledger_initial")}
         n_broken = int(f.attrs["bonds_broken"])
     c = sim.corr
     sim.u[:n], sim.v[:n], sim.a[:] = data["u"], data["v"], data["a"]
@@ -217,8 +242,11 @@ def restore(sim, path) -> None:
     if sim.gas is not None:
         gas = sim.gas
         gas.gd[:n, 6], gas.gd[:n, 7] = data["gas_V"], data["gas_p"]
+        gas.gd[:n, :6] = data["gas_A"]
+        gas.V_w[:n] = data["gas_Vw"]
+        sim.halo.exchange(gas.V_w)
         gas.e[:] = data["gas_e"][gas.gas_idx]
-        gas.V_ratio[gas.gas_idx] = gas.gd[gas.gas_idx, 6] / gas.V0
+        gas.V_ratio[gas.gas_idx] = gas.V_w[gas.gas_idx] / gas.V0
     sim.step_count, sim.t = step, t
     sim.external_work = work if team.root else 0.0
     # rebuild what follows from the state
@@ -232,6 +260,23 @@ def restore(sim, path) -> None:
         fl.refresh_damage()
         if sim.interface is not None:       # retired where bonds broke or families failed
             sim.interface.retire(sim.mode)
+    led = sim.ledger
+    own = team.root                                 # global sums, held once
+    led.viscous_work = ledger["ledger_viscous_work"] if own else 0.0
+    led.interface_work = ledger["ledger_interface_work"] if own else 0.0
+    led.jumps = ledger["ledger_jumps"] if own else 0.0
+    led.contact_jumps = ledger["ledger_contact_jumps"] if own else 0.0
+    led.initial = ledger["ledger_initial"]
+    if len(led.edamp):
+        led.edamp[:] = data["ledger_edamp"]
+    for key, arr in sim.peaks.arrays.items():
+        if len(arr):
+            arr[:] = data[key]
+    c.Jfac[:] = data["Jfac"]
     sim.initialize()
     sim.a[:] = data["a"]
     c.F_old[:] = data["F_old"]
+    if len(led.fv_old):
+        led.fv_old[:] = data["ledger_fv_old"]
+    if sim.interface is not None:
+        led.fc_old[:] = data["ledger_fc_old"][sim.interface.idx]

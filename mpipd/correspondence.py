@@ -2,7 +2,7 @@
 
 :class:`Correspondence` owns the per-point kinematic state of the owned points
 — K^-1, F (this and last step), Fdot, rotation R, left stretch V, unrotated
-stress, strain energy — and the per-point force data of all local points.  It
+stress, stress work, volume factor — and the per-point force data of all local points.  It
 calls the kernels of :mod:`mpipd.kernels.nosb` and
 :mod:`mpipd.kernels.rotation`; materials only see the unrotated rate of
 deformation ``d`` and update the unrotated stress of their own points.
@@ -10,8 +10,8 @@ deformation ``d`` and update the unrotated stress of their own points.
 Step order (DESIGN §4, steps 4–8)::
 
     deform(u, v)        F, Fdot                         Eqs. 5, 13
-    rotate(dt)          R, V, d, J                      Eqs. 6–14
-    update_stress(dt)   materials, strain energy        Eq. 19 / 36
+    rotate(dt)          R, V, d, J (c det F)            Eqs. 6–14
+    update_stress(dt)   materials, stress work          Eq. 19 / 36
     force_data()        B = P K^-1 - h F, h              Eqs. 2, 3, 15
     (halo exchange of fd)
     gather(u, f)        internal force density           Eq. 1
@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .kernels import integrate, nosb, rotation
+from .kernels import energy, integrate, nosb, rotation
 from .kernels.viscosity import viscosity_data
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
@@ -70,7 +70,9 @@ class Correspondence:
         self.sigma = np.zeros((n, 6))           # unrotated Cauchy stress, Voigt
         self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
         self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
-        self.J_end = np.ones(n)                 # det F at the end of the step (materials)
+        self.J_end = np.ones(n)                 # c det F at the end of the step (materials)
+        self.Jfac = np.ones(n)                  # volume factor c (rebuild_shape)
+        self.toggled = np.zeros(n, np.int64)    # points that switched to/from code 2
         self.W = np.zeros(n)                    # strain energy per reference volume
         self.gamma = np.zeros(n)                # sum_j omega V_j (Eq. 43)
         self.contact = bool(contact)
@@ -93,15 +95,38 @@ class Correspondence:
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
 
     # ---------------------------------------------------------------- steps
-    def rebuild_shape(self, which: np.ndarray | None = None) -> int:
+    def rebuild_shape(self, which: np.ndarray | None = None, u=None) -> int:
         """K^-1 of the given owned points (default: all).  Returns the number of
-        owned points on the bond-spring fallback afterwards."""
+        owned points on the bond-spring fallback afterwards.
+
+        Given the current displacement ``u`` (a rebuild after bonds broke), the
+        points' F is recomputed over their new families at that u, F' = N'(u) K'^-1,
+        and the volume factor keeps the volume ratio continuous:
+
+            c <- c det F / det F'      (so c' det F' = c det F),
+
+        F and F_old become F' (the next rotation increment then compares F's
+        of one family).  Without it J = det F jumps when a family turns
+        one-sided (a JH2 point went 133 MPa -> 18 GPa through K3 mu^3 with no
+        work done) and the pressure then does work that nothing put in.
+        """
         p, fam = self.points, self.families
         if which is None:
             which = np.arange(p.n_owned, dtype=np.int64)
+        before = self.spring[which] == 0
         nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
                            self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
         self.spring[self.not_tl] = 3
+        if u is not None and len(which):
+            Fn = np.empty((len(which), 3, 3))
+            nosb.gradients_of(which, p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
+                              fam.broken, self.Kinv, self.spring, Fn)
+            j_old = np.linalg.det(self.F[which])
+            j_new = np.linalg.det(Fn)
+            ok = before & (self.spring[which] == 0) & (j_old > 0) & (j_new > 0)
+            self.Jfac[which[ok]] *= j_old[ok] / j_new[ok]
+            self.F[which] = Fn
+            self.F_old[which] = Fn
         self.n_spring = self.count_spring()
         return self.n_spring
 
@@ -117,7 +142,7 @@ class Correspondence:
 
     def rotate(self, dt: float):
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
-                                self.spring, self.d, self.J, self.J_end)
+                                self.spring, self.d, self.J, self.J_end, self.Jfac)
 
     def update_stress(self, dt: float, mode: np.ndarray):
         """Materials advance the stress; ``mode`` (failure flags) may be set by them."""
@@ -130,20 +155,24 @@ class Correspondence:
         """Tension failure model (Eqs. 37–38) of the materials that have one."""
         return sum(g.check_tension(self.sigma, self.d, mode) for g in self.groups)
 
-    def force_data(self) -> int:
-        n_bad = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK, self.spring,
-                                self.hg_modulus, self.fd)
+    def force_data(self) -> np.ndarray:
+        """Force data of the owned points; returns the points that switched to or
+        from the singular-F fallback (code 2) in this call."""
+        n_bad, n_tog = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK,
+                                       self.spring, self.hg_modulus, self.Jfac, self.fd,
+                                       self.toggled)
         if self.viscosity is not None:
             viscosity_data(self.dil, self.gamma, self.J, self.trK, self.spring,
                            self.visc_l, self.visc_q, self.fd)
-        if n_bad:
+        if n_bad or n_tog:
             self.n_spring = self.count_spring()
-        return n_bad
+        return self.toggled[:n_tog]
 
-    def gather(self, u, v, f):
+    def gather(self, u, v, f, fv):
+        """Internal force density into f; the viscous share also into fv (if any)."""
         p, fam = self.points, self.families
         nosb.gather_forces(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.fd, self.cbb, self.contact, f)
+                           self.fd, self.cbb, self.contact, f, fv)
 
     def commit(self):
         self.F_old[...] = self.F
@@ -168,11 +197,26 @@ class Correspondence:
         T = self.R[i] @ S @ self.R[i].T
         return np.array([T[0, 0], T[1, 1], T[2, 2], T[1, 2], T[0, 2], T[0, 1]])
 
-    def strain_energy(self) -> float:
-        n = self.points.n_owned
-        return float(np.dot(self.W, self.points.volume[:n]))
+    def elastic_energy(self, mode) -> np.ndarray:
+        """Recoverable energy per reference volume of every owned point (J/m^3),
+        from each material's own state (0 for failed points and the gas)."""
+        out = np.zeros(self.points.n_owned)
+        for g in self.groups:
+            g.material.elastic_energy(g.idx, self.sigma, self.J_end, mode, g.state, self.W,
+                                      out)
+        return out
+
+    def potentials(self, rows: np.ndarray, u) -> np.ndarray:
+        """(hourglass, spring, contact) energy (J) owned by each of the owned points
+        ``rows``, at displacement u with the current bonds, F, K and fallback codes
+        (kernels.energy)."""
+        p, fam = self.points, self.families
+        out = np.empty((len(rows), 3))
+        energy.point_potentials(rows, p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
+                                fam.broken, self.F, self.hg_modulus, self.trK, self.spring,
+                                self.cbb, self.contact, out)
+        return out
 
     def hourglass_energy(self, u) -> float:
-        p, fam = self.points, self.families
-        return nosb.hourglass_energy(p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                     fam.broken, self.F, self.fd, self.spring)
+        rows = np.arange(self.points.n_owned, dtype=np.int64)
+        return float(self.potentials(rows, u)[:, 0].sum())

@@ -10,7 +10,11 @@ owned points in ``mode`` (1 JH2 plastic, 2 JH2 tensile, 3 tension model):
    (largest horizon + dx_k / 2); only those candidates' bonds are tested
    (mpipd.kernels.breakage), never all bonds;
 3. owned points that lost bonds get a new shape tensor (bond-spring fallback
-   where too few bonds are left) and a new damage phi (Eq. 39);
+   where too few bonds are left), with F recomputed over the new family at the
+   current displacement and the volume factor that keeps J continuous
+   (Correspondence.rebuild_shape), and a new damage phi (Eq. 39);  the held
+   potentials (hourglass, spring, contact) of the candidates before and of the
+   changed points after are booked as ``removed`` in the energy ledger;
 4. owned points with phi = 1 join the damped set (Eq. 41).
 
 Each rank breaks only its owned points' bonds, by the same rule from the same
@@ -26,7 +30,7 @@ from scipy.spatial import cKDTree
 from .kernels.breakage import break_bonds, pairs_from_lists, pd_damage
 
 class Failure:
-    def __init__(self, points, families, halo, corr, damping: float, damp, tl):
+    def __init__(self, points, families, halo, corr, damping: float, damp, tl, ledger=None):
         self.points = points
         self.families = families
         self.halo = halo
@@ -41,12 +45,14 @@ class Failure:
         self.tl = tl[:n]                        # only total-Lagrangian points have damage
         self.tree = cKDTree(points.x)
         self.reach = float(points.horizon.max()) if nl else 0.0
+        self.ledger = ledger
         self.bonds_broken = 0
         self.seconds = 0.0                      # wall time spent here (bookkeeping share)
         self.refresh_damage()
 
-    def update(self) -> int:
-        """Exchange failure flags and break bonds.  Returns the newly failed local points."""
+    def update(self, u) -> int:
+        """Exchange failure flags and break bonds (u: the current displacement).
+        Returns the newly failed local points."""
         t0 = time.perf_counter()
         self.halo.exchange(self.mode)
         new = np.flatnonzero((self.mode != 0) & (self.done == 0))
@@ -56,12 +62,17 @@ class Failure:
             lists = self.tree.query_ball_point(p.x[new], self.reach + 0.5 * p.dx[new])
             rows, items = pairs_from_lists(lists)
             own = items < p.n_owned
+            cand = np.unique(items[own])
+            before = self.corr.potentials(cand, u) if self.ledger is not None else None
             self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx,
                                              fam.offsets, fam.nbr, fam.broken, self.touched)
             changed = np.flatnonzero(self.touched)
             if len(changed):
                 self.touched[changed] = 0
-                self.corr.rebuild_shape(changed)
+                self.corr.rebuild_shape(changed, u)
+                if self.ledger is not None:
+                    self.ledger.book_jump(before[np.searchsorted(cand, changed)],
+                                          self.corr.potentials(changed, u))
                 pd_damage(changed, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
                 if self.damping > 0:
                     self.damp[changed] = np.where(self.phi[changed] >= 1.0, self.damping, 0.0)

@@ -13,8 +13,8 @@ material.
   eligible point has moved more than half the skin since: until then every pair
   within the horizon is in the list.  The kernels keep only pairs inside the
   horizon, in gid order, so the result is exactly that of a search every step.
-* Kernels: mpipd.kernels.ul.  Gas energy (per initial volume) is conserved with
-  the work the gas does; it is reported as ``/energy/gas``.
+* Kernels: mpipd.kernels.ul.  The gas energy (per initial volume) changes by
+  exactly the trapezoidal work of the gas's forces; it is the ledger's ``gas``.
 """
 from __future__ import annotations
 
@@ -56,7 +56,9 @@ class Gas:
         self.t_ramp = m.burn_ramp * dx / m.vod
         self.gas_horizon = np.where(self.is_gas.astype(bool), p.horizon, 0.0)
         self.reach = sim.team.max(float(self.gas_horizon.max()) if p.n_local else 0.0)
-        self.V_ratio = np.ones(n)
+        self.V_ratio = np.ones(n)                # V_w / V0 of the owned gas (1 elsewhere)
+        self.V_w = self.gd[:, 6].copy()          # this step's pair weights (start-of-step V)
+        self.V_pw = self.V_w.copy()              # the last step's
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
         self.skin = SKIN * self.reach
@@ -100,11 +102,12 @@ class Gas:
         p, m = self.points, self.mat
         y = self.y = p.x + u                    # current positions, kept for gather()
         self.search(y)
+        self.V_pw, self.V_w = self.V_w, self.gd[:, 6].copy()
         self.n_singular = gas_update(
-            self.gas_idx, y, v, p.volume, self.gd[:, 6].copy(), self.gd, p.horizon,
+            self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas)
-        self.V_ratio[self.gas_idx] = self.gd[self.gas_idx, 6] / self.V0
+        self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, 7].max()))
 
@@ -112,7 +115,7 @@ class Gas:
         """UL forces into f; u must be the displacement update() last saw."""
         p = self.points
         y = self.y if self.y is not None else p.x + u
-        gas_gather(self.rows, y, p.volume, self.V_ratio, self.gd, p.horizon,
+        gas_gather(self.rows, y, p.volume, self.V_w, self.V_ratio, self.gd, p.horizon,
                    self.offsets, self.nbr, self.is_gas, f)
 
     def energy(self) -> float:

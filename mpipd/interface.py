@@ -93,6 +93,7 @@ class InterfaceCorrection:
                        int((~(full | planar)).sum()))
         self.active = np.ones(len(self.idx), dtype=np.uint8)
         self.families = fam
+        self.fc = np.zeros((len(self.idx), 3))       # this step's correction force density
 
     @staticmethod
     def _near_interface(p, fam, halo) -> np.ndarray:
@@ -115,7 +116,7 @@ class InterfaceCorrection:
 
     def apply(self, fd, F, f):
         """f_i -= P_i g_i at the active corrected points."""
-        kern.subtract_ghost_force(fd, F, self.idx, self.q, self.active, f)
+        kern.subtract_ghost_force(fd, F, self.idx, self.q, self.active, f, self.fc)
 
     def retire(self, mode) -> int:
         """Switch off the correction where bonds broke or a family member failed."""

@@ -10,9 +10,10 @@ does not depend on the number of ranks that wrote it::
     /geometry/volume        (N,)
     /geometry/material      (N,)  material id (attrs: names)
     /geometry/part          (N,)  part index (attrs: names)
-    /fields/<name>          (n_frames, N[, k])   u, v, stress, strain_energy
+    /fields/<name>          (n_frames, N[, k])   u, v, stress, stress_work, elastic_energy,
+                                                 peak_* (running peaks), ...
     /time                   (n_frames,)
-    /energy/{t, kinetic, strain, hourglass, gas, total, external}   (n_frames,)
+    /energy/<term>          (n_frames,)  the energy ledger (mpipd.ledger.TERMS)
     /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
@@ -26,6 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .ledger import TERMS
+from .peaks import NAMES as PEAKS
 from .scene import OUTPUT_FIELDS
 
 
@@ -60,7 +63,9 @@ FIELD_VALUES = {
     "u": lambda sim: sim.u[:sim.points.n_owned],
     "v": lambda sim: sim.v[:sim.points.n_owned],
     "stress": lambda sim: sim.corr.cauchy_stress(),
-    "strain_energy": lambda sim: sim.corr.W,
+    "stress_work": lambda sim: sim.corr.W,
+    "elastic_energy": lambda sim: sim.corr.elastic_energy(sim.mode),
+    **{k: (lambda sim, k=k: sim.peaks.arrays[k]) for k in PEAKS},
     "damage": lambda sim: sim.failure.phi,
     "failure_mode": lambda sim: sim.failure.mode[:sim.points.n_owned].astype(np.float64),
     "jh2_damage": _state("D"),
@@ -133,9 +138,11 @@ class Writer:
             self.dsets[name] = fg.create_dataset(name, shape, "f8")
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8")
         eg = self.f.create_group("energy")
-        self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8")
-                       for k in ("t", "kinetic", "strain", "hourglass", "gas", "total",
-                                 "external")}
+        eg.attrs["doc"] = ("energy ledger (J), see mpipd.ledger: held = kinetic + integrator + "
+                           "elastic + hourglass + spring + contact + gas; dissipated = plastic "
+                           "+ removed + viscous + damping + gas_damping + interface; balance = "
+                           "(initial + external - held - dissipated) / scale")
+        self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8") for k in TERMS}
         if sim.probes is not None:
             sim.probes.create(self.f, n_steps + 1)
 
@@ -151,10 +158,7 @@ class Writer:
         g0, g1 = sim.gid_range
         for name, d in self.dsets.items():
             self._write(d, np.s_[k, g0:g1], field_values(sim, name))
-        e = sim.energies()
-        values = {"t": sim.t, "kinetic": e.kinetic, "strain": e.strain,
-                  "hourglass": e.hourglass, "gas": e.gas, "total": e.total,
-                  "external": e.external}
+        values = {"t": sim.t, **sim.energies().as_dict()}
         # small per-frame scalars: every rank writes the same value collectively
         self._write(self.time, np.s_[k:k + 1], np.array([sim.t]))
         for key, d in self.energy.items():

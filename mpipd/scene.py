@@ -44,7 +44,10 @@ HORIZON_TOL = 1e-3
 
 #: per-point fields that ``[output] fields`` may name: components and what the scene needs
 OUTPUT_FIELDS = {
-    "u": (3, None), "v": (3, None), "stress": (6, None), "strain_energy": (1, None),
+    "u": (3, None), "v": (3, None), "stress": (6, None),
+    "stress_work": (1, None),            # W: stress work per reference volume (J/m^3)
+    "elastic_energy": (1, None),         # recoverable part of W (J/m^3; 0 once failed)
+    "peak_pressure": (1, None), "peak_sigma_rr": (1, None), "peak_speed": (1, None),  # peaks
     "damage": (1, "failure"),            # PD damage phi (Eq. 39)
     "failure_mode": (1, "failure"),      # 0 intact, 1 JH2 D >= 1, 2 JH2 p* < -T*, 3 tension model
     "jh2_damage": (1, "jh2"), "pressure": (1, "pressure"), "plastic_strain": (1, "plastic"),
@@ -194,13 +197,19 @@ class Solver:
     phi = 1 (the paper's 0.2 per microsecond is 2e5 1/s); 0 switches it off.
     ``contact`` turns on Eq. 40 on broken bonds; ``viscosity`` Eqs. 42–44.
     ``interface_correction`` removes the ghost force where dx or the horizon
-    changes (mpipd.interface); it only exists in scenes whose parts differ."""
+    changes (mpipd.interface); it only exists in scenes whose parts differ.
+    ``refresh_after_break`` recomputes the forces after a step in which bonds
+    broke, so the next half kick uses the broken state's forces: velocity Verlet
+    otherwise applies the pre-break force for one more half step, a first-order
+    error at each breakage (it shows in the energy ledger's balance); it costs a
+    second force evaluation on such steps."""
     hourglass: float = 0.01
     progress_every: int = 0           # steps between progress lines; 0 = about every 2 s
     contact: bool = False
     damping: float = 0.0
     viscosity: Viscosity | None = None
     interface_correction: bool = True
+    refresh_after_break: bool = False
 
     def check(self, path):
         non_negative(self, path, "hourglass", "progress_every", "damping")
@@ -208,14 +217,21 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
+    """``every`` (steps between frames), ``fields``, ``checkpoint_every``, and
+    ``peak_center``: the (x, y) of the z axis about which ``peak_sigma_rr`` is
+    radial (mpipd.peaks)."""
     every: int = 10
     fields: tuple[str, ...] = ("u", "v")
     checkpoint_every: int = 0         # steps between checkpoints; 0 = only on signal/stop
+    peak_center: tuple[float, float] = (0.0, 0.0)
 
     def check(self, path):
         positive(self, path, "every")
         non_negative(self, path, "checkpoint_every")
         for i, f in enumerate(self.fields):
+            if f == "strain_energy":
+                fail(join(join(path, "fields"), i), "'strain_energy' is now 'stress_work' "
+                     "(total stress work); 'elastic_energy' is its recoverable part")
             if f not in OUTPUT_FIELDS:
                 fail(join(join(path, "fields"), i),
                      f"unknown field {f!r} (known: {', '.join(OUTPUT_FIELDS)})")

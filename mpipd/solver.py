@@ -22,7 +22,6 @@ No MPI call appears here except through the halo and the team.
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,28 +33,14 @@ from .geometry import LayerTable
 from .gas import Gas
 from .halo import Halo
 from .interface import InterfaceCorrection, needed as interface_needed
-from .probes import Probes
 from .kernels import integrate
+from .ledger import Energies, Ledger
+from .peaks import Peaks
+from .probes import Probes
 
 
 class Unstable(RuntimeError):
     """Non-finite values appeared; the message names the step, field, gid and position."""
-
-
-@dataclass
-class Energies:
-    """Global energies (J).  ``total`` is the mechanical energy; ``external`` the
-    work done so far by the loads, so total - external is what the run conserves
-    (or dissipates)."""
-    kinetic: float
-    strain: float
-    hourglass: float
-    external: float = 0.0
-    gas: float = 0.0
-
-    @property
-    def total(self) -> float:
-        return self.kinetic + self.strain + self.hourglass + self.gas
 
 
 class Simulation:
@@ -104,8 +89,10 @@ class Simulation:
         needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
         self.damp = np.zeros(n) if needs_damp else np.zeros(0)
         # failure and bond breakage exist only if some material can fail
+        self.ledger = Ledger(n, damped=len(self.damp) > 0, viscous=sv.viscosity is not None,
+                             n_interface=len(self.interface.idx) if self.interface else 0)
         self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping, self.damp,
-                                self.tl) if scene.can_fail else None)
+                                self.tl, self.ledger) if scene.can_fail else None)
         self.mode = self.failure.mode if self.failure else np.zeros(p.n_local, np.uint8)
         # the explosive gas exists only if the scene has one
         self.gas = Gas(self) if gas_parts else None
@@ -117,8 +104,10 @@ class Simulation:
         self.external_work = 0.0
         self.step_count = 0
         self.t = 0.0
+        self.peaks = Peaks(self, scene.output)
         self.initialize()
         self.probes = Probes(self, scene.probes) if scene.probes else None
+        self.energies()                         # the ledger's initial energy (step 0)
 
     def initialize(self):
         """F from the current (initial) displacement and the forces it gives."""
@@ -130,20 +119,47 @@ class Simulation:
         self.compute_forces()
         self.apply_loads(self.t, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
+        self.ledger.start(self.interface)
+        self.peaks.sample(self)
 
     # ------------------------------------------------------------------ pipeline
     def compute_forces(self):
         """Force data of owned points -> halo -> gathered internal force density."""
-        self.corr.force_data()
+        toggled = self.corr.force_data()
+        if len(toggled):                            # points that switched to/from code 2
+            self._book_toggles(toggled)
         if self.gas is not None:
             self.halo.exchange(self.corr.fd, self.gas.gd)
         else:
             self.halo.exchange(self.corr.fd)
-        self.corr.gather(self.u, self.v, self.f)
+        self.corr.gather(self.u, self.v, self.f, self.ledger.fv)
         if self.interface is not None:
             self.interface.apply(self.corr.fd, self.corr.F, self.f)
         if self.gas is not None:
             self.gas.gather(self.u, self.f)
+
+    def _refresh_forces(self, dt: float):
+        """Forces of the state after this step's breakage, for the next half kick
+        (Solver.refresh_after_break).  The integrator term -(dt^2/8) sum m |a|^2
+        jumps with a; the ledger books the jump like any other discontinuity."""
+        before = self.ledger.integrator(self)
+        self.compute_forces()
+        if self.loads:
+            self.apply_loads(self.t + dt, 0.0)
+        integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
+        self.ledger.start(self.interface)
+        self.ledger.jumps += before - self.ledger.integrator(self)
+
+    def _book_toggles(self, rows):
+        """A point whose F became singular (or regular again) switched between the
+        correspondence model and the bond-spring fallback: its held potentials
+        jump; the ledger books before - after."""
+        c = self.corr
+        now = c.spring[rows].copy()
+        c.spring[rows] = np.where(now == 2, 0, 2).astype(np.uint8)
+        before = c.potentials(rows, self.u)
+        c.spring[rows] = now
+        self.ledger.book_jump(before, c.potentials(rows, self.u))
 
     def apply_loads(self, t: float, dt: float):
         """Add the loads' body forces at time t to f; accumulate their work over the
@@ -173,28 +189,31 @@ class Simulation:
 
     def step(self):
         dt = self.dt
-        integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed, self.damp)
+        integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed, self.damp,
+                             self.ledger.edamp)
         self.update(dt)
+        self.ledger.book_work(self.v, self.points.volume, dt, self.interface)
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
+        self.peaks.sample(self)
         if self.failure is not None:                # paper §2.7 steps 11–12
             self.corr.check_tension(self.mode)
-            if self.failure.update() and self.interface is not None:
+            new = self.failure.update(self.u)
+            if new and self.interface is not None:
                 self.interface.retire(self.mode)
+            if self.scene.solver.refresh_after_break and self.team.max(int(new > 0)):
+                self._refresh_forces(dt)
         self.step_count += 1
         self.t = self.step_count * dt
 
     # ------------------------------------------------------------------ diagnostics
     def energies(self) -> Energies:
-        n = self.points.n_owned
-        ke = integrate.kinetic_energy(self.v, self.rho, self.points.volume[:n])
-        local = np.array([ke, self.corr.strain_energy(), self.corr.hourglass_energy(self.u),
-                          self.external_work, self.gas.energy() if self.gas else 0.0])
-        tot = self.team.sum(local)
-        if not np.all(np.isfinite(tot)):
+        """The energy ledger now (global; mpipd.ledger)."""
+        e = self.ledger.read(self)
+        if not np.isfinite(e.held + e.dissipated):
             self.check_finite()
             raise Unstable(f"non-finite energy at step {self.step_count} (t = {self.t:.4e} s): "
                            "the run went unstable; compare dt with `mpipd check`")
-        return Energies(*map(float, tot))
+        return e
 
     def check_finite(self):
         """Raise :class:`Unstable` on every rank if any owned u, v or stress is NaN/Inf,
@@ -330,7 +349,7 @@ class Progress:
             return
         self._last = wall
         failed = int(sim.failure_counts()[1:].sum()) if sim.failure is not None else 0
-        energy = sim.energies().total
+        e = sim.energies()
         if not self.team.root:
             return
         rate = sim.n_bonds_global * done / max(wall, 1e-12)
@@ -338,4 +357,4 @@ class Progress:
         self.log(f"step {sim.step_count:>7d}/{sim.step_count - done + total:<7d} "
                  f"t={sim.t * 1e6:9.4f} us  wall={wall:8.1f} s  eta={eta:8.1f} s  "
                  f"{rate / 1e6:8.2f} M bond-steps/s ({rate / self.team.size / 1e6:.2f} per rank)  "
-                 f"failed={failed}  E={energy:.5g} J")
+                 f"failed={failed}  E={e.held:.5g} J  balance={e.balance:+.2e}")

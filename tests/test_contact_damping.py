@@ -60,7 +60,7 @@ def test_fully_failed_region_carries_compression(team, contact):
     x = sim.points.x[:n]
     mid = (x[:, 0] > 0.010) & (x[:, 0] < 0.020)
     sim.failure.mode[:n][mid] = 1               # crushed: every bond of the region breaks
-    sim.failure.update()
+    sim.failure.update(sim.u)
     assert np.all(sim.failure.phi[mid] == 1.0)
     left, right = x[:, 0] < 0.010, x[:, 0] > 0.020
     sim.v[:n][left, 0] = 10.0
@@ -80,7 +80,7 @@ def test_damping_of_fully_damaged_points_follows_eq41(team):
     sim = Simulation(block([0.005, 0.005, 0.005], contact=False, damping=c, dt=dt), team)
     n = sim.points.n_owned
     sim.failure.mode[:n] = 1
-    sim.failure.update()
+    sim.failure.update(sim.u)
     assert np.all(sim.failure.damp == c)
     sim.v[:n] = [3.0, -1.0, 2.0]
     sim.initialize()

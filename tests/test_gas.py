@@ -66,17 +66,20 @@ def test_detonation_identical_on_1_2_3_ranks(det_runs):
 
 
 def test_energy_bookkeeping(det_runs):
-    """Gas energy + the work done on copper and rock (kinetic + strain) stays equal
-    to the chemical energy released, e0 times the charge volume."""
+    """The ledger of the detonation (gas, copper, rock): its initial energy is the
+    chemical energy e0 times the charge volume, and what is held plus what was
+    dissipated stays equal to it (|balance| measured 1e-5 at this resolution)."""
     with h5py.File(det_runs[1], "r") as f:
         e = f["energy"]
         mat = f["geometry/material"][...]
         V = f["geometry/volume"][...]
         released = 7.38e9 * V[mat == 0].sum()
-        total = e["total"][...]
         assert e["gas"][0] == pytest.approx(released, rel=1e-12)
+        assert e["initial"][0] == pytest.approx(released, rel=1e-12)
         assert e["kinetic"][-1] > 0.2 * released            # a real blast happened
-        assert np.abs(total - released).max() < 0.01 * released
+        assert np.abs(e["balance"][...]).max() < 1e-4
+    with h5py.File(det_runs[3], "r") as f:                 # and on 3 ranks alike
+        assert np.abs(f["energy/balance"][...]).max() < 1e-4
 
 
 def test_jwl_pressure_at_unreacted_density(team):

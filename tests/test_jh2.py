@@ -166,3 +166,38 @@ def test_hydrostatic_tension_fails_at_minus_T():
         assert pt.sigma[0, 0] == pytest.approx(-p, rel=1e-12)
     else:
         pytest.fail("never reached -T")
+
+
+def test_no_bulking_in_tension_and_no_sign_change():
+    """Eq. 26 applied at mu < 0 would take p from -K1|mu| to about +K1|mu| in one
+    yield step; mpipd bulks only under compression, so a damaging point in
+    tension keeps p = K1 mu (dp = 0) and its sign."""
+    mu = -0.0015                                  # p = K1 mu = -32.9 MPa, above -T
+    pt, h = shear_run(mu, 2000.0, 2e-8, beta=1.0, steps=20000, D1=0.4)
+    plastic = h[:, 2] > 0
+    assert plastic.sum() > 100 and h[plastic, 1].max() > 0.05   # damage accumulated
+    live = h[:, 5] == 0
+    assert np.all(h[live, 3] == 0.0)                            # no bulking pressure
+    np.testing.assert_allclose(h[live, 4], K1 * mu, rtol=1e-12)  # p keeps its sign
+    # what Eq. 26 would have given at the first damaging step: the sign flipped
+    k = int(np.argmax(plastic & (h[:, 1] > 0)))
+    D0, D1_ = (h[k - 1, 1] if k else 0.0), h[k, 1]
+    p = K1 * mu
+    edot = 2 / math.sqrt(3) * 2000.0
+    dU = (strength(p, edot, D0) ** 2 - strength(p, edot, D1_) ** 2) / (6 * G)
+    literal = -K1 * mu + math.sqrt((K1 * mu) ** 2 + 2 * 1.0 * K1 * dU)
+    assert p + literal > 0 > p
+
+
+def test_eos_energy_is_the_integral_of_the_pressure():
+    """eos_energy(mu) = -int_1^J p dJ', checked with scipy's adaptive quadrature in
+    J, on both branches and through the negative-tangent range."""
+    from scipy.integrate import quad
+
+    from mpipd.materials.jh2 import eos_energy
+    for mu in (-0.004, -1e-4, 1e-4, 0.003, 0.005, 0.02, 0.1):
+        J = 1.0 / (1.0 + mu)
+        want = -quad(lambda j: jh2_pressure(1.0 / j - 1.0, K1, K2, K3), 1.0, J,
+                     epsabs=0, epsrel=1e-13)[0]
+        assert want > 0
+        assert eos_energy(mu, K1, K2, K3) == pytest.approx(want, rel=1e-11)

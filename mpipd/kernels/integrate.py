@@ -10,13 +10,19 @@ import numba
 
 
 @numba.njit(cache=True)
-def kick_drift(u, v, a, dt, fixed, damp):
+def kick_drift(u, v, a, dt, fixed, damp, edamp):
     """Half kick then drift, owned points (rows of ``a``).
 
     Points with damp[i] = c > 0 (``damp`` may be empty) follow the damped update of
     Eq. 41, v_{n+1/2} = [(2 - c dt) v_{n-1/2} + 2 dt a_n] / (2 + c dt), written
     with v_n = v_{n-1/2} + dt/2 a_n as
     v_{n+1/2} = [(2 - c dt) v_n + (1 + c dt / 2) dt a_n] / (2 + c dt).
+
+    That is the undamped half kick plus the velocity impulse
+    delta = -kappa v_n, kappa = 2 c dt / (2 + c dt).  Against velocity Verlet's
+    energy identity (kernels.energy) the impulse removes, per unit mass,
+    -(v_n . delta + |delta|^2 / 2) = 4 c dt |v_n|^2 / (2 + c dt)^2 >= 0
+    (-> c |v|^2 dt, the continuous damping power), accumulated in edamp[i].
     """
     h = 0.5 * dt
     damped = damp.shape[0] > 0
@@ -27,6 +33,7 @@ def kick_drift(u, v, a, dt, fixed, damp):
             continue
         if damped and damp[i] > 0.0:
             cd = damp[i] * dt
+            edamp[i] += 4.0 * cd * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2) / (2.0 + cd) ** 2
             for c in range(3):
                 v[i, c] = ((2.0 - cd) * v[i, c] + (1.0 + 0.5 * cd) * dt * a[i, c]) / (2.0 + cd)
                 u[i, c] += dt * v[i, c]
@@ -54,7 +61,8 @@ def kick(v, f, rho, dt, fixed, a):
 
 @numba.njit(cache=True)
 def stress_power(sigma, d, J, dt, spring, W):
-    """W += dt J sigma : d  (strain energy per reference volume; P : Fdot = J sigma : D).
+    """W += dt J sigma : d  (stress work per reference volume, elastic + plastic;
+    P : Fdot = J sigma : D).
 
     Called with dt/2 before and after the stress update, this is the
     trapezoidal rule on the stress power.

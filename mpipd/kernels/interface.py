@@ -51,9 +51,13 @@ def interface_vectors(x, vol, horizon, offsets, nbr, broken, kinv, points, g):
 
 
 @numba.njit(cache=True)
-def subtract_ghost_force(fd, F, idx, q, active, f):
-    """f_i -= A_i q_i with A_i = B_i + h_i F_i, at the active points ``idx``."""
+def subtract_ghost_force(fd, F, idx, q, active, f, fc):
+    """f_i -= A_i q_i with A_i = B_i + h_i F_i, at the active points ``idx``;
+    fc[p] = -A_i q_i, the correction's force density (0 where it does not act),
+    for the energy ledger."""
     for p in range(idx.shape[0]):
+        for r in range(3):
+            fc[p, r] = 0.0
         if not active[p]:
             continue
         i = idx[p]
@@ -65,6 +69,7 @@ def subtract_ghost_force(fd, F, idx, q, active, f):
             for c in range(3):
                 acc += (fd[i, 3 * r + c] + h * F[i, r, c]) * q[p, c]
             f[i, r] -= acc
+            fc[p, r] = -acc
 
 
 @numba.njit(cache=True)

@@ -177,14 +177,56 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
 
 
 @numba.njit(cache=True)
-def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
+def gradients_of(rows, x, u, vol, horizon, offsets, nbr, broken, Kinv, spring, F):
+    """F (Eq. 5) of the owned points ``rows`` only (I where spring[i] is odd), into
+    F[p] for rows[p]: the same sums, in the same order, as deformation_gradients."""
+    N = np.empty((3, 3))
+    for p in range(rows.shape[0]):
+        i = rows[p]
+        for r in range(3):
+            for c in range(3):
+                N[r, c] = 0.0
+                F[p, r, c] = 1.0 if r == c else 0.0
+        if spring[i] % 2 == 1:
+            continue
+        di = horizon[i]
+        for b in range(offsets[i], offsets[i + 1]):
+            if broken[b]:
+                continue
+            j = nbr[b]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            w = influence(di, r) * vol[j]
+            y0 = w * (e0 + (u[j, 0] - u[i, 0]))
+            y1 = w * (e1 + (u[j, 1] - u[i, 1]))
+            y2 = w * (e2 + (u[j, 2] - u[i, 2]))
+            N[0, 0] += y0 * e0
+            N[0, 1] += y0 * e1
+            N[0, 2] += y0 * e2
+            N[1, 0] += y1 * e0
+            N[1, 1] += y1 * e1
+            N[1, 2] += y1 * e2
+            N[2, 0] += y2 * e0
+            N[2, 1] += y2 * e1
+            N[2, 2] += y2 * e2
+        mul3(N, Kinv[i], F[p])
+
+
+@numba.njit(cache=True)
+def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
     """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
-    fd[i, 9] = h, fd[i, 10] = 1.0 for a bond-spring point, else 0.0, with A = J sigma F^-T K^-1, sigma = R sigma_unrot R^T, h = 2 M / tr K.
+    fd[i, 9] = h, fd[i, 10] = 1.0 for a bond-spring point, else 0.0, with
+    A = c J sigma F^-T K^-1 (J = det F, c = Jfac[i] the volume factor),
+    sigma = R sigma_unrot R^T, h = 2 M / tr K.
 
     ``hg_modulus[i]`` is c * M of the point's material.  Points whose K cannot
     be inverted (``spring[i] = 1``, set by shape_tensors) use the bond-spring
     fallback; so, for this step only, does a point whose F is singular or not
-    finite (``spring[i] = 2``, re-tested every step).  Returns how many those are.
+    finite (``spring[i] = 2``, re-tested every step).  The points that switched
+    between 0 and 2 in this call are written to ``toggled`` (their energy is
+    booked by the ledger).  Returns (points on code 2, points toggled).
     """
     n_owned = F.shape[0]
     S = np.empty((3, 3))
@@ -193,14 +235,19 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
     Finv = np.empty((3, 3))
     P = np.empty((3, 3))
     n_bad = 0
+    n_tog = 0
     for i in range(n_owned):
         if spring[i] % 2 == 0:
+            was = spring[i]
             J = det3(F[i])
             if J > 0.0 and math.isfinite(J):
                 spring[i] = 0
             else:
                 spring[i] = 2          # singular (or non-finite) F this step
                 n_bad += 1
+            if spring[i] != was:
+                toggled[n_tog] = i
+                n_tog += 1
         if spring[i]:
             for c in range(10):
                 fd[i, c] = 0.0
@@ -209,7 +256,7 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
         voigt_to_mat(sigma[i], S)
         mul3(R[i], S, T1)
         mul3_bt(T1, R[i], T2)          # sigma = R S R^T
-        J = inv3(F[i], Finv)
+        J = Jfac[i] * inv3(F[i], Finv)
         mul3_bt(T2, Finv, T1)          # sigma F^-T
         for r in range(3):
             for c in range(3):
@@ -221,16 +268,17 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, fd):
                 fd[i, 3 * r + c] = T1[r, c] - h * F[i, r, c]
         fd[i, 9] = h
         fd[i, 10] = 0.0
-    return n_bad
+    return n_bad, n_tog
 
 
 @numba.njit(cache=True)
-def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact, f):
+def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact, f, fv):
     """Internal force density f (N/m^3) of every owned point (see module docstring).
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
-    (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, 11:13] and v.
+    (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, 11:13] and v; its
+    share of f is also written to ``fv`` (for the energy ledger's viscous work).
     """
     n = offsets.shape[0] - 1
     visc = fd.shape[1] > 11
@@ -244,6 +292,7 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
         di = horizon[i]
         si = fd[i, 10]
         fx = fy = fz = 0.0
+        gx = gy = gz = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = nbr[k]
             e0 = x[j, 0] - xi0
@@ -290,6 +339,10 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
                 tx -= c * e0
                 ty -= c * e1
                 tz -= c * e2
+                cv = c * vol[j]
+                gx -= cv * e0
+                gy -= cv * e1
+                gz -= cv * e2
             vj = vol[j]
             fx += tx * vj
             fy += ty * vj
@@ -297,6 +350,10 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
         f[i, 0] = fx
         f[i, 1] = fy
         f[i, 2] = fz
+        if visc:
+            fv[i, 0] = gx
+            fv[i, 1] = gy
+            fv[i, 2] = gz
 
 
 @numba.njit(cache=True, inline="always")
@@ -306,26 +363,3 @@ def _spring(c, r, y0, y1, y2):
     if ly == 0.0:
         return 0.0
     return 0.5 * c * (ly / r - 1.0) / ly
-
-
-@numba.njit(cache=True)
-def hourglass_energy(x, u, vol, horizon, offsets, nbr, broken, F, fd, spring):
-    """E_hg = sum_i V_i (h_i / 2) sum_j omega_i |Y - F_i xi|^2 V_j over owned points."""
-    n = offsets.shape[0] - 1
-    total = 0.0
-    for i in range(n):
-        if spring[i]:
-            continue
-        di = horizon[i]
-        acc = 0.0
-        for k in range(offsets[i], offsets[i + 1]):
-            if broken[k]:
-                continue
-            j = nbr[k]
-            e0, e1, e2, r, w = bond(x, i, j, di)
-            z0 = e0 + u[j, 0] - u[i, 0] - (F[i, 0, 0] * e0 + F[i, 0, 1] * e1 + F[i, 0, 2] * e2)
-            z1 = e1 + u[j, 1] - u[i, 1] - (F[i, 1, 0] * e0 + F[i, 1, 1] * e1 + F[i, 1, 2] * e2)
-            z2 = e2 + u[j, 2] - u[i, 2] - (F[i, 2, 0] * e0 + F[i, 2, 1] * e1 + F[i, 2, 2] * e2)
-            acc += w * (z0 * z0 + z1 * z1 + z2 * z2) * vol[j]
-        total += vol[i] * 0.5 * fd[i, 9] * acc
-    return total

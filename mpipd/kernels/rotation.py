@@ -26,13 +26,17 @@ from .linalg import det3, inv3, mat_to_voigt, mul3, mul3_at
 
 
 @numba.njit(cache=True)
-def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end):
-    """Advance R and V of every owned point by dt; write d (Voigt), J = det F_mid
+def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
+    """Advance R and V of every owned point by dt; write d (Voigt), J = c det F_mid
     (for the stress power and the viscosity, which live at mid-step) and
-    J_end = det F_{n+1}: the volume the new stress acts on, from which a
+    J_end = c det F_{n+1}: the volume the new stress acts on, from which a
     total-volume EOS (JH2's mu = 1/J - 1) must take its pressure.  Taking it
     from F_mid would delay the restoring force by dt/2, which makes the central
-    difference scheme unstable at any dt (growth ~ (omega dt)^2 / 4 a step)."""
+    difference scheme unstable at any dt (growth ~ (omega dt)^2 / 4 a step).
+
+    c = ``Jfac[i]`` is the point's volume factor (1 until its shape tensor is
+    rebuilt after bonds broke; see Correspondence.rebuild_shape): the volume
+    ratio of the point is c det F, continuous across a change of family."""
     n = F_new.shape[0]
     Fm = np.empty((3, 3))
     Fi = np.empty((3, 3))
@@ -56,9 +60,10 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end):
             J[i] = 1.0
             J_end[i] = 1.0
             continue
-        J[i] = inv3(Fm, Fi)
+        c = Jfac[i]
+        J[i] = c * inv3(Fm, Fi)
         Je = det3(F_new[i])
-        J_end[i] = Je if (Je > 0.0 and math.isfinite(Je)) else Jm
+        J_end[i] = c * (Je if (Je > 0.0 and math.isfinite(Je)) else Jm)
         mul3(Fdot[i], Fi, L)
         for r in range(3):
             for c in range(3):

@@ -7,17 +7,29 @@ For an owned gas point i over its current family (gas and the solids it acts on)
     M_i = sum_j omega_i Y (x) Y V_j                      (Eq. 45)
     L_i = [sum_j omega_i Ydot (x) Y V_j] M_i^-1           (Eq. 46)
     V_i <- V_i exp(tr L_i dt),  V_R = V_i / V0_i        (volume from tr L)
-    e_i <- e_i - p_i (V_R,new - V_R,old)                 (adiabatic, per initial volume)
+    e_i <- e_i - (p_i,old + p_i,new)/2 (V_R,new - V_R,old)   (adiabatic, per initial volume)
     p_i = lambda(t) k JWL(V_R, e_i),  A_i = sigma_i M_i^-1 = -p_i M_i^-1   (Eqs. 47, 48)
 
-with lambda the programmed-burn fraction and k the explosive's pressure
-factor.  Force density on any owned point i, per unit reference volume:
+Energy.  The internal energy changes by exactly the trapezoidal work of the
+point's own force state (what the energy ledger books for every force, the
+"compatible" energy update of Owen 2014 for SPH).  Pair weights are the
+volumes at the start of the step, V^w, for M, N and the force alike (so the
+force from state i on the pair (i, j), V^w_i V^w_j omega A_i Y, is equal and
+opposite); the work of state i's force over the step's displacement
+dY = dt Ydot (u^{n+1} - u^n = dt v^{n+1/2}) is
 
-    f_i = (V_i / V0_i) sum_j [omega_i A_i Y + omega_j A_j Y] V_j
+    W = -V^w_i A_i : sum_j omega V^w_j dY (x) Y = p_i V^w_i tr(M_i^-1 N_i) dt,
 
-(gathered; omega is zero for a solid's own side).  The power of these forces
-is sum_i V_i p_i tr L_i, exactly the rate at which the energy equation takes
-energy out of the gas, so energy is conserved up to the time discretisation.
+evaluated for the force of the last step (A^n, positions y^n = y - dt v,
+weights V^{w,n}: W_a) and of this step (A^{n+1} = -p^{n+1} M^-1: W_b = p^{n+1} b,
+b = V^w_i tr L_i dt), and
+
+    e^{n+1} V0 = e^n V0 - (W_a + W_b) / 2.
+
+JWL is linear in e, p = lam k (f(V_R) + w e / V_R), so the implicit update has
+the closed form e^{n+1} = (e^n V0 - W_a/2 - lam k f b/2) / (V0 + lam k w b / (2 V_R)).
+The volume itself, V <- V exp(tr L dt), is the EOS's argument.
+
 Per point, the halo carries gd = [A (6, Voigt), V, p].
 """
 import math
@@ -42,13 +54,14 @@ def current_bond(y, i, j):
 
 
 @numba.njit(cache=True)
-def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
+def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
                V0, e, A, B, R1, R2, w, kfac, is_gas):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
-    (rows = owned points); ``V_snap`` the gas volumes at the start of the step (so
-    the result does not depend on the update order).  Returns the number of gas
-    points with a singular M."""
+    (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
+    step's pair weights, so the result does not depend on the update order) and
+    ``V_pw`` those of the step before (the last force's weights).  Returns the
+    number of gas points with a singular M."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
     N = np.empty((3, 3))
@@ -61,15 +74,29 @@ def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_l
                 M[r, c] = 0.0
                 N[r, c] = 0.0
         nb = 0
+        wa = 0.0                                # -A^n : sum omega V dt Ydot (x) Y^n
+        a0, a1, a2 = gd[i, 0], gd[i, 1], gd[i, 2]
+        a3, a4, a5 = gd[i, 3], gd[i, 4], gd[i, 5]
+        old = a0 != 0.0 or a1 != 0.0 or a2 != 0.0 or a3 != 0.0 or a4 != 0.0 or a5 != 0.0
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
-            y0, y1, y2, ly = current_bond(y, i, j)
-            if ly >= di:
-                continue
-            wgt = (di - ly) * (di - ly) * (V_snap[j] if is_gas[j] else V_ref[j])
             z0 = v[j, 0] - v[i, 0]
             z1 = v[j, 1] - v[i, 1]
             z2 = v[j, 2] - v[i, 2]
+            if old:                             # the last force, at y^n = y - dt v
+                q0 = y[j, 0] - y[i, 0] - dt * z0
+                q1 = y[j, 1] - y[i, 1] - dt * z1
+                q2 = y[j, 2] - y[i, 2] - dt * z2
+                lq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+                if lq < di:
+                    wq = (di - lq) * (di - lq) * (V_pw[j] if is_gas[j] else V_ref[j])
+                    wa -= wq * (a0 * z0 * q0 + a1 * z1 * q1 + a2 * z2 * q2
+                                + a3 * (z1 * q2 + z2 * q1) + a4 * (z0 * q2 + z2 * q0)
+                                + a5 * (z0 * q1 + z1 * q0))
+            y0, y1, y2, ly = current_bond(y, i, j)
+            if ly >= di:
+                continue
+            wgt = (di - ly) * (di - ly) * (V_w[j] if is_gas[j] else V_ref[j])
             M[0, 0] += wgt * y0 * y0
             M[0, 1] += wgt * y0 * y1
             M[0, 2] += wgt * y0 * y2
@@ -86,6 +113,7 @@ def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_l
             N[2, 1] += wgt * z2 * y1
             N[2, 2] += wgt * z2 * y2
             nb += 1
+        W_a = wa * V_pw[i] * dt
         M[1, 0] = M[0, 1]
         M[2, 0] = M[0, 2]
         M[2, 1] = M[1, 2]
@@ -104,17 +132,17 @@ def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_l
                     trL += N[r, c] * Mi[c, r]          # tr(N M^-1)
         else:
             n_bad += 1
-        V_old = V_snap[i]
+        V_old = V_w[i]
         V_new = V_old * math.exp(trL * dt)
-        p_old = gd[i, 7]
-        e[k] -= p_old * (V_new - V_old) / V0[k]
         lam = 1.0 if t_ramp <= 0.0 else (t - t_lit[k]) / t_ramp
         lam = 0.0 if lam < 0.0 else (1.0 if lam > 1.0 else lam)
         VR = V_new / V0[k]
-        p = 0.0
-        if lam > 0.0:
-            p = lam * kfac * (A * (1.0 - w / (R1 * VR)) * math.exp(-R1 * VR)
-                              + B * (1.0 - w / (R2 * VR)) * math.exp(-R2 * VR) + w * e[k] / VR)
+        lk = lam * kfac
+        f = (A * (1.0 - w / (R1 * VR)) * math.exp(-R1 * VR)
+             + B * (1.0 - w / (R2 * VR)) * math.exp(-R2 * VR))
+        bb = V_old * trL * dt                   # W_b = p^{n+1} bb (0 if singular)
+        e[k] = (e[k] * V0[k] - 0.5 * W_a - 0.5 * lk * f * bb) / (V0[k] + 0.5 * lk * w * bb / VR)
+        p = lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0
         gd[i, 6] = V_new
         gd[i, 7] = p
         if singular or p == 0.0:
@@ -131,8 +159,9 @@ def gas_update(gas_idx, y, v, V_ref, V_snap, gd, delta, offsets, nbr, dt, t, t_l
 
 
 @numba.njit(cache=True)
-def gas_gather(rows, y, V_ref, V0_ratio, gd, delta, offsets, nbr, is_gas, f):
-    """Add the updated-Lagrangian pair forces to f of the owned points ``rows``."""
+def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f):
+    """Add the updated-Lagrangian pair forces to f of the owned points ``rows``
+    (pair weights V_w for gas points, V_ref for solids; V0_ratio = V_w / V0)."""
     for k in range(rows.shape[0]):
         i = rows[k]
         di = delta[i] if is_gas[i] else 0.0
@@ -153,7 +182,7 @@ def gas_gather(rows, y, V_ref, V0_ratio, gd, delta, offsets, nbr, is_gas, f):
                     tx += w * (gd[j, 0] * y0 + gd[j, 5] * y1 + gd[j, 4] * y2)
                     ty += w * (gd[j, 5] * y0 + gd[j, 1] * y1 + gd[j, 3] * y2)
                     tz += w * (gd[j, 4] * y0 + gd[j, 3] * y1 + gd[j, 2] * y2)
-            vj = gd[j, 6] if is_gas[j] else V_ref[j]
+            vj = V_w[j] if is_gas[j] else V_ref[j]
             fx += tx * vj
             fy += ty * vj
             fz += tz * vj

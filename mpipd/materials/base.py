@@ -3,7 +3,26 @@ from __future__ import annotations
 
 import math
 
+import numba
+
 from ..schema import positive
+
+
+@numba.njit(cache=True)
+def hypoelastic_energy(idx, sigma, J, mode, K, G, out):
+    """Recoverable energy per reference volume of a linear solid's points ``idx``:
+    out[i] = J (p^2 / (2 K) + S : S / (4 G)), p = -tr(sigma)/3, S = dev(sigma);
+    0 for failed points (their stress is zero)."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        if mode[i] != 0:
+            out[i] = 0.0
+            continue
+        p = -(sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
+        a, b, c = sigma[i, 0] + p, sigma[i, 1] + p, sigma[i, 2] + p
+        ss = a * a + b * b + c * c + 2.0 * (sigma[i, 3] ** 2 + sigma[i, 4] ** 2
+                                            + sigma[i, 5] ** 2)
+        out[i] = J[i] * (p * p / (2.0 * K) + ss / (4.0 * G))
 
 
 class Material:
@@ -34,3 +53,13 @@ class Material:
 
     def new_state(self, n: int) -> dict:
         return {}
+
+    #: False for a material without a dissipation mechanism (the hypoelastic solid):
+    #: its stress work is its stored energy and the ledger books no plastic part
+    dissipative = True
+
+    def elastic_energy(self, idx, sigma, J, mode, state, W, out):
+        """out[i] = recoverable energy per reference volume (J/m^3) of the points
+        ``idx`` (W: their stress work).  Default: the linear solid's stress-based
+        energy (:func:`hypoelastic_energy`)."""
+        hypoelastic_energy(idx, sigma, J, mode, self.bulk_modulus, self.shear_modulus, out)

@@ -46,6 +46,13 @@ class Elastic(Material):
     shear_modulus: float
     tension: TensionFailure | None = None
 
+    dissipative = False
+
+    def elastic_energy(self, idx, sigma, J, mode, state, W, out):
+        """A hypoelastic solid has no potential of its own and no dissipation: its
+        stored (recoverable) energy is its stress work W (0 once failed)."""
+        out[idx] = np.where(mode[idx] != 0, 0.0, W[idx])
+
     def update(self, idx: np.ndarray, d: np.ndarray, J: np.ndarray, dt: float,
                sigma: np.ndarray, mode: np.ndarray, state: dict) -> None:
         hypoelastic_update(idx, d, dt, sigma, mode, self.lame_lambda, self.shear_modulus)

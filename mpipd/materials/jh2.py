@@ -24,7 +24,15 @@ Per point and step, in the unrotated frame (d from Eq. 6, dt):
        D += deps_p / eps_f,  eps_f = D1 (p* + T*)^D2;  D >= 1  ->  the point fails (mode 1).
 6. Bulking (Eqs. 26–28): the strength lost to the damage step, at this p* and
    edot*, releases dU = [sigma_y(D_old)^2 - sigma_y(D_new)^2] / (6 G) > 0 and
-       dp <- -K1 mu + sqrt((K1 mu + dp)^2 + 2 beta K1 dU).
+       dp <- -K1 mu + sqrt((K1 mu + dp)^2 + 2 beta K1 dU)
+   — only where the point is in compression (p >= 0 before the step).  Eq. 26
+   is the energy balance (p_new^2 - p_old^2) / (2 K1) = beta dU of a linear
+   pressure, which raises |p|; applied literally in tension (K1 mu + dp < 0)
+   its positive root flips the sign of p (-44 MPa -> +44 MPa), i.e. turns a
+   tensile point into a compressed one with no volume change.  Bulking is
+   dilatancy of crushed material under compression (Johnson & Holmquist 1994),
+   so in tension dp is left unchanged and dU is dissipated (the ledger's
+   ``plastic``).  In compression p only grows, so no yield step changes its sign.
 7. sigma = S - (p_EOS + dp) I (Eq. 35); the correspondence module rotates it (Eq. 36).
 
 A failed point carries no stress; its bonds break (mpipd.failure).
@@ -52,6 +60,41 @@ def jh2_pressure(mu, K1, K2, K3):
     if mu >= 0.0:
         return K1 * mu + K2 * mu * mu + K3 * mu * mu * mu
     return K1 * mu
+
+
+#: 8-point Gauss–Legendre nodes and weights on [-1, 1]
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+
+
+@numba.njit(cache=True)
+def eos_energy(mu, K1, K2, K3):
+    """Energy per reference volume stored by the EOS (Eq. 25 without bulking) at
+    compression mu: E = -int_1^J p dJ' = int_0^mu p(m) / (1 + m)^2 dm (J = 1/(1 + mu)),
+    by 8-point Gauss–Legendre (the integrand is smooth on each branch; exact to
+    round-off for |mu| < 0.3).  E >= 0: p has the sign of mu for Table 1."""
+    h = 0.5 * mu
+    e = 0.0
+    for k in range(8):
+        m = h * (1.0 + _GL_X[k])
+        e += _GL_W[k] * jh2_pressure(m, K1, K2, K3) / ((1.0 + m) * (1.0 + m))
+    return h * e
+
+
+@numba.njit(cache=True)
+def jh2_elastic_energy(idx, sigma, J, mode, G, K1, K2, K3, out):
+    """Recoverable energy per reference volume: J S:S / (4 G) + eos_energy(1/J - 1)
+    (the bulking pressure's work is not recoverable: it stays in the stress work,
+    on the dissipated side); 0 for failed points."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        if mode[i] != 0:
+            out[i] = 0.0
+            continue
+        m = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
+        a, b, c = sigma[i, 0] - m, sigma[i, 1] - m, sigma[i, 2] - m
+        ss = a * a + b * b + c * c + 2.0 * (sigma[i, 3] ** 2 + sigma[i, 4] ** 2
+                                            + sigma[i, 5] ** 2)
+        out[i] = J[i] * ss / (4.0 * G) + eos_energy(1.0 / J[i] - 1.0, K1, K2, K3)
 
 
 @numba.njit(cache=True, inline="always")
@@ -125,7 +168,7 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
             D[k] = D_new
             sy_new = sigma_hel * jh2_strength(ps, rate, D_new, A, N, B, M, T_star)
             dU = (sy * sy - sy_new * sy_new) / (6.0 * G)
-            if dU > 0.0:
+            if dU > 0.0 and p >= 0.0:
                 x = K1 * mu + dp[k]
                 dp[k] = -K1 * mu + math.sqrt(x * x + 2.0 * beta * K1 * dU)
                 p = p_eos + dp[k]
@@ -190,6 +233,10 @@ class JH2(Material):
                    s["strain_rate"], self.shear_modulus, self.bulk_modulus, self.K2, self.K3,
                    self.sigma_hel, self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T,
                    self.beta, self.D1, self.D2, self.rate_norm)
+
+    def elastic_energy(self, idx, sigma, J, mode, state, W, out):
+        jh2_elastic_energy(idx, sigma, J, mode, self.shear_modulus, self.bulk_modulus,
+                           self.K2, self.K3, out)
 
     def negative_tangent(self) -> tuple[float, float] | None:
         """The compression range (mu_lo, mu_hi) where dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 < 0."""

@@ -139,3 +139,8 @@ class Explosive(JWL):
 
     def update(self, idx, d, J, dt, sigma, mode, state):
         """The gas has no correspondence stress (mpipd.gas handles it)."""
+
+    def elastic_energy(self, idx, sigma, J, mode, state, W, out):
+        """No correspondence stress, no elastic energy (the gas's own energy is
+        booked as ``gas``)."""
+        out[idx] = 0.0
