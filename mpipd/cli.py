@@ -219,6 +219,12 @@ def _run(args, team, signals=None) -> int:
     if sim.failure is not None:
         log(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
             f"{failed[3]} tension model; {broken} bonds broken")
+    from .ledger import impossible
+    e = sim.energies()
+    log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "
+        f"held {e.held:.6g} J + dissipated {e.dissipated:.6g} J; balance {e.balance:+.2e}")
+    for msg in impossible(e):
+        log(f"mpipd: warning: impossible energy: {msg}", error=True)
     if sim.gas is not None:
         peak = team.max(sim.gas.peak_pressure)
         m = sim.gas.mat

@@ -140,6 +140,12 @@ class Correspondence:
                                    fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
                                    self.dil)
 
+    def initial_volume(self):
+        """J_end = c det F of the current F (the start of a run, before any step)."""
+        J = np.linalg.det(self.F)
+        ok = (self.spring % 2 == 0) & (J > 0)
+        self.J_end[:] = np.where(ok, self.Jfac * J, 1.0)
+
     def rotate(self, dt: float):
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
                                 self.spring, self.d, self.J, self.J_end, self.Jfac)

@@ -42,14 +42,17 @@ from .geometry import LayerTable
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
 BYTES_PER_LOCAL_POINT = 209     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb, mode
-BYTES_PER_OWNED_POINT = 642     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
-#                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group index
+BYTES_PER_OWNED_POINT = 666     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
+#                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
+#                                 index, volume factor, fallback toggles, ledger row index
 BYTES_PER_BOND = 5              # nbr (int32) + broken (uint8)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
-DAMPING_OWNED = 8
-VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 24
+DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
+VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 72   # fd columns; dilatation, viscous force (2 steps)
 JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
-GAS_LOCAL, GAS_OWNED = 74, 24   # gas force data (8), flags, gas horizon; UL offsets, V ratio, damping
+GAS_LOCAL, GAS_OWNED = 90, 32   # gas force data (8), flags, gas horizon, pair weights (2 steps);
+#                                 UL offsets, V ratio, damping, the ledger's damping energy
+PEAKS_OWNED = 24                # peak_pressure, peak_sigma_rr, peak_speed (if asked for)
 BYTES_PER_GAS_POINT = 48        # index, V0, e, lighting time, eligible/row lists
 
 
@@ -62,17 +65,20 @@ def memory_model(scene) -> tuple[int, int]:
     scene with an explosive adds BYTES_PER_GAS_POINT per gas point on every rank
     (plus its current-configuration families)."""
     local, owned = BYTES_PER_LOCAL_POINT, BYTES_PER_OWNED_POINT
-    if any(is_gas_part(scene, q) for q in scene.parts):
+    gas = any(is_gas_part(scene, q) for q in scene.parts)
+    if gas:
         local += GAS_LOCAL
-        owned += GAS_OWNED
+        owned += GAS_OWNED            # includes the (one) damping array and its energy
     if scene.can_fail:
         local += FAILURE_LOCAL
-        owned += FAILURE_OWNED + (DAMPING_OWNED if scene.solver.damping > 0 else 0)
+        owned += FAILURE_OWNED + (DAMPING_OWNED if scene.solver.damping > 0 and not gas else 0)
     if scene.solver.viscosity is not None:
         local += VISCOSITY_LOCAL
         owned += VISCOSITY_OWNED
     if scene.has_model("jh2"):
         owned += JH2_OWNED            # an upper bound when only some parts are JH2
+    if any(f.startswith("peak_") for f in scene.output.fields):
+        owned += PEAKS_OWNED
     return local, owned
 
 

@@ -110,11 +110,20 @@ class Simulation:
         self.energies()                         # the ledger's initial energy (step 0)
 
     def initialize(self):
-        """F from the current (initial) displacement and the forces it gives."""
+        """F from the current (initial) displacement and the forces it gives.
+
+        At step 0 the state's stored energy becomes its stress work: a material
+        whose pressure is a function of the volume (JH2's EOS) holds the energy
+        of an initial displacement from the start (W_0 = e_el(J_0)), so the
+        ledger's initial energy includes it."""
         if getattr(self, "gas", None) is not None:
             self.gas.y = None                   # positions come from u, not a past update
         self.halo.exchange(self.u, self.v)
         self.corr.deform(self.u, self.v)
+        if self.step_count == 0:
+            self.corr.initial_volume()
+            self.corr.W[:] = 0.0
+            self.corr.W[:] = self.corr.elastic_energy(self.mode)
         self.corr.commit()
         self.compute_forces()
         self.apply_loads(self.t, 0.0)

@@ -64,8 +64,9 @@ def test_output_layout_and_xdmf(runs):
         assert f.attrs["mpipd_version"]
         t = f["time"][...]
         np.testing.assert_allclose(np.diff(t), 20 * 2e-7, rtol=1e-9)
-        e = f["energy/total"][...]
+        e = f["energy/kinetic"][...] + f["energy/elastic"][...] + f["energy/hourglass"][...]
         assert e[0] > 0 and np.abs(e - e[0]).max() < 0.01 * e[0]
+        assert np.abs(f["energy/balance"][...]).max() < 1e-6      # the ledger closes
     xdmf = runs[2].with_suffix(".xdmf").read_text()
     root = ET.fromstring(xdmf)                                # well-formed XML
     grids = root.findall("./Domain/Grid/Grid")

@@ -391,18 +391,17 @@ def test_unconfined_gas_expands_without_bound_stably(team):
     """A bare charge detonated from one end blows apart over 3 us: gas points reach
     V/V0 in the hundreds and lose their neighbourhoods (counted as singular: no
     force).  No NaN; the energy stays positive and finite; gas energy plus kinetic
-    energy exceeds the released e0 V by 1.3 % at dt = 0.3 dt_c and by half that at
-    0.15 dt_c: the explicit gas energy update (e -= p_old dV) gains O(dt) during the
-    fast expansion (reported; a trapezoidal update would remove the first-order term)."""
+    energy stays the released e0 V to round-off (the energy equation is the
+    trapezoidal work of the gas's own forces, kernels.ul; the explicit e -= p_old dV
+    it replaced gained 1.3 % here at dt = 0.3 dt_c, first order in dt)."""
     sim, worst, lit_p = expand_freely(team, 0.3)
     V = sim.gas.gd[sim.gas.gas_idx, 6] / sim.gas.V0
     assert V.max() > 50                                   # very large expansion reached
     assert np.all(np.isfinite(sim.gas.e)) and np.all(sim.gas.e > 0)
     assert sim.gas.n_singular > 0                         # isolated points, counted
     assert 0.5 < np.median(lit_p) < 1.5                   # burning at ~ the unreacted density
-    assert 0.0 < worst < 0.02
-    _, worst_half, _ = expand_freely(team, 0.15)
-    assert 1.6 < worst / worst_half < 2.4                 # first order in dt: consistent
+    assert abs(worst) < 1e-12                            # measured 4e-16
+    assert abs(sim.energies().balance) < 1e-12
 
 
 # ----------------------------------------------------------------------------- bonds
@@ -533,3 +532,49 @@ def test_jh2_block_at_extreme_strain_rates(team, rate, kind):
         sim.v[:n, 0] = rate * x[:, 1]
     Watch(sim, tol=1e-3, scale=sim.energies().kinetic).run(40)
     assert sim.failure_counts()[1:].sum() > 0.5 * n
+
+
+# ----------------------------------------------------------------------------- the blast
+# The paper's 0.8 mm specimen blew up (issue 13): a rock point at r = 7.7 mm held
+# -1590 J of stored work and moved at 34 km/s.  The same failure shows in a reduced
+# demo at the paper's rock resolution: before the volume factor of
+# Correspondence.rebuild_shape, this run (commit 3abcb55) ended at 8 us with 8 rock
+# points below -1e7 J/m^3 (-2.97 J in all, min -7.3e8 J/m^3), a rock point at
+# 537 m/s and 32 JH2 tensile failures; after it, none below zero, 59 m/s, 0.
+
+@pytest.fixture(scope="module")
+def blast_08(team):
+    from mpipd import scene as sc
+    from mpipd.ledger import impossible
+    scene, _ = sc.load("blast_demo", ["parts.2.dx=8e-4", "parts.2.shape.radius=0.015",
+                                      "time.t_end=8e-6"])
+    sim = Simulation(scene, team)
+    worst = 0.0
+    for _ in range(scene.time.n_steps):
+        sim.step()
+        if sim.step_count % 20 == 0:
+            e = sim.energies()
+            worst = max(worst, abs(e.balance))
+            assert not impossible(e), impossible(e)
+    return sim, sim.energies(), worst
+
+
+def test_blast_at_the_paper_rock_resolution_stays_physical(blast_08):
+    sim, e, _ = blast_08
+    n = sim.points.n_owned
+    W = sim.corr.W
+    assert W.min() > -1e-6 * W.max()                     # no negative stored work
+    speed = np.linalg.norm(sim.v[:n], axis=1)
+    rock = sim.points.material[:n] == list(sim.scene.materials).index("granite")
+    assert speed[rock].max() < 200.0                     # measured 59 m/s (537 before)
+    assert speed[rock].max() < speed[sim.gas.gas_idx].max()
+    assert sim.failure_counts()[2] == 0                  # no JH2 tensile artefacts (32 before)
+
+
+def test_blast_ledger_closes(blast_08):
+    from test_ledger import closure_without
+    sim, e, worst = blast_08
+    assert worst < 1e-4                                  # measured 1.2e-5
+    assert e.gas_damping > 0 and e.plastic > 0 and e.kinetic > 0.3 * e.initial
+    for term in ("gas_damping", "gas", "plastic", "removed", "contact"):
+        assert closure_without(e, term) > 1e-4, term

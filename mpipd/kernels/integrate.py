@@ -26,6 +26,7 @@ def kick_drift(u, v, a, dt, fixed, damp, edamp):
     """
     h = 0.5 * dt
     damped = damp.shape[0] > 0
+    book = edamp.shape[0] > 0
     for i in range(a.shape[0]):
         if fixed[i]:
             for c in range(3):
@@ -33,7 +34,8 @@ def kick_drift(u, v, a, dt, fixed, damp, edamp):
             continue
         if damped and damp[i] > 0.0:
             cd = damp[i] * dt
-            edamp[i] += 4.0 * cd * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2) / (2.0 + cd) ** 2
+            if book:
+                edamp[i] += 4.0 * cd * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2) / (2.0 + cd) ** 2
             for c in range(3):
                 v[i, c] = ((2.0 - cd) * v[i, c] + (1.0 + 0.5 * cd) * dt * a[i, c]) / (2.0 + cd)
                 u[i, c] += dt * v[i, c]
