@@ -1,7 +1,10 @@
 """Probes: named points whose state is recorded every step (paper Figs. 15–16).
 
-Each probe is the lattice point nearest its ``position`` (lowest gid on a tie);
-the rank that owns it records, every step,
+Each probe is the lattice point nearest its ``position`` (lowest gid on a tie),
+among the points of its ``part`` if it names one (a part name matches the part
+and its zones ``<part>.band``, ``<part>.0``, ... of :meth:`mpipd.scene.Part.zones`,
+so ``part = "rock"`` samples the rock whatever its resolution bands); the rank
+that owns it records, every step,
 
     t, sigma_rr, v_r            radial stress and velocity about the axis through ``center``
     p                           pressure -tr(sigma)/3 (compression positive)
@@ -9,9 +12,11 @@ the rank that owns it records, every step,
     strength                    JH2 yield strength sigma_y at the point's p*, edot*, D
                                 (NaN for other materials)
 
-into ``/probes/<name>/{t, sigma_rr, v_r, p, s, strength}`` and ``/probes/<name>``
-attributes ``gid`` and ``x``.  Rows are kept in memory between frames and
-written by the owner at each frame.
+into ``/probes/<name>/{t, sigma_rr, v_r, p, s, strength}``, with ``/probes/<name>``
+attributes ``gid``, ``position`` (requested), ``x`` (the chosen point), ``distance``
+(m, from the requested position to the chosen point), ``part`` (the zone holding
+the point), ``material`` and ``requested_part`` (the probe's ``part``, "" if none).
+Rows are kept in memory between frames and written by the owner at each frame.
 """
 from __future__ import annotations
 
@@ -27,10 +32,17 @@ QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
 
 @dataclass(frozen=True)
 class Probe:
-    """``name``, ``position`` (m), ``center`` (x, y) of the radial axis (default 0, 0)."""
+    """``name``, ``position`` (m), ``center`` (x, y) of the radial axis (default 0, 0),
+    ``part``: the part whose points it may snap to (default: any point)."""
     name: str
     position: tuple[float, float, float]
     center: tuple[float, float] = (0.0, 0.0)
+    part: str | None = None
+
+
+def part_matches(part: str, name: str) -> bool:
+    """Does the scene part (or zone) ``name`` belong to the probe's ``part``?"""
+    return name == part or name.startswith(part + ".")
 
 
 class Probes:
@@ -40,13 +52,29 @@ class Probes:
         n = sim.points.n_owned
         x = sim.points.x[:n]
         gid = sim.points.gid[:n]
+        part = sim.points.part[:n]
+        mat = sim.points.material[:n]
+        parts = [q.name for q in sim.scene.parts]
+        self.part_names, self.material_names = parts, list(sim.scene.materials)
         self.mine = []                      # (probe index, local index)
-        self.gid, self.x = [], []
+        self.gid, self.x, self.dist, self.part, self.material = [], [], [], [], []
         for k, pr in enumerate(self.probes):
             d = np.linalg.norm(x - np.asarray(pr.position), axis=1) if n else np.empty(0)
-            best = (float(d.min()), int(gid[np.argmin(d)])) if n else (math.inf, -1)
-            dist, g = min(sim.team.gather(best))
+            if pr.part is not None:
+                ok = np.array([part_matches(pr.part, q) for q in parts], bool)
+                d = np.where(ok[part], d, np.inf)
+            j = int(np.argmin(d)) if n else -1
+            best = ((float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
+                     int(mat[j])) if n and np.isfinite(d[j]) else (math.inf, -1))
+            found = min(sim.team.gather(best))
+            if not math.isfinite(found[0]):
+                raise ValueError(f"probe {pr.name!r}: no point of part {pr.part!r}")
+            dist, g, xg, pg, mg = found
             self.gid.append(g)
+            self.x.append(xg)
+            self.dist.append(dist)
+            self.part.append(parts[pg])
+            self.material.append(self.material_names[mg])
             local = np.flatnonzero(gid == g)
             if len(local):
                 self.mine.append((k, int(local[0])))
@@ -107,6 +135,11 @@ class Probes:
             grp = h5.require_group(f"probes/{pr.name}")
             grp.attrs["gid"] = self.gid[k]
             grp.attrs["position"] = pr.position
+            grp.attrs["x"] = self.x[k]
+            grp.attrs["distance"] = self.dist[k]
+            grp.attrs["part"] = self.part[k]
+            grp.attrs["material"] = self.material[k]
+            grp.attrs["requested_part"] = pr.part or ""
             self.dsets[k] = {q: grp.require_dataset(q, (n_rows,), "f8", fillvalue=np.nan)
                              for q in QUANTITIES}
 

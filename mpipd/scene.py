@@ -11,7 +11,8 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
-    [[probes]]    name, position, center (radial axis): recorded every step
+    [[probes]]    name, position, center (radial axis), part (snap to that part's
+                  points only): recorded every step
     [output]      every (steps), fields
 
 Horizon.  A part's horizon is delta = horizon_factor * dx * (1 + HORIZON_TOL)
@@ -37,7 +38,7 @@ import numpy as np
 from .geometry import SHAPES
 from .loads import BOUNDARIES, INITIAL, LOADS
 from .materials import MATERIALS
-from .probes import Probe
+from .probes import Probe, part_matches
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3
@@ -282,6 +283,10 @@ class Scene:
             if pr.name in seen or not pr.name.isidentifier():
                 fail(f"probes[{i}].name", f"probe names must be unique identifiers ({pr.name!r})")
             seen.add(pr.name)
+            if pr.part is not None and not any(part_matches(pr.part, p.name)
+                                               for p in self.parts):
+                known = ", ".join(p.name for p in self.parts)
+                fail(f"probes[{i}].part", f"no part {pr.part!r} (parts: {known})")
         needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
                  "plastic": self.has_model("jh2") or self.has_model("j2"),
                  "pressure": self.has_model("jh2") or self.has_model("jwl")}

@@ -1,6 +1,7 @@
 """``mpirun -n N python -m postprocess {summary | wave-speed | fracture | report | compare} RUN.h5``
 
-summary      points, frames, time span, energy drift, peak |v| per frame
+summary      points, frames, time span, energy drift (or the ledger's largest |balance|),
+             peak |v| per frame
 wave-speed   arrival speed of a pulse: the peak time of the cross-section mean of
              one velocity component at several stations along an axis, fitted by a
              straight line (parabolic interpolation of each peak between frames)
@@ -31,12 +32,18 @@ class UsageError(Exception):
 
 def summary(run: Run, comm) -> list[str]:
     from mpi4py import MPI
-    v = run.field("v") if "v" in run.f["fields"] else None
-    e = run.energy("total")
+    v = run.field("v") if run.has_field("v") else None
     t = run.time
-    lines = [f"points {run.n_points}  frames {run.frames}  t {t[0]:.4e}..{t[-1]:.4e} s",
-             f"energy total {e[0]:.6e} -> {e[-1]:.6e} J, max drift "
-             f"{np.abs(e - e[0]).max() / abs(e[0]) if e[0] else float('nan'):.3e} (relative)"]
+    lines = [f"points {run.n_points}  frames {run.frames}  t {t[0]:.4e}..{t[-1]:.4e} s"]
+    if run.has_energy("balance"):
+        b = np.abs(run.energy("balance"))
+        lines.append(f"energy ledger: largest |balance| {np.nanmax(b):.3e} (relative closure "
+                     "error)")
+    elif run.has_energy("total"):
+        e = run.energy("total")
+        lines.append(f"energy total {e[0]:.6e} -> {e[-1]:.6e} J, max drift "
+                     f"{np.abs(e - e[0]).max() / abs(e[0]) if e[0] else float('nan'):.3e} "
+                     "(relative)")
     if v is not None:
         local = np.sqrt((v ** 2).sum(axis=2)).max(axis=1) if v.shape[1] else np.zeros(run.frames)
         peak = np.empty_like(local)

@@ -12,12 +12,17 @@ Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
 sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
 zone, and the median for the count of major radial cracks.
+
+Peaks (gas, wall, PPV profile) are over every step (:mod:`postprocess.peaks`, the
+probes), never over the saved frames alone; impossible values are gathered in
+``errors`` (:mod:`postprocess.errors`) and shown as errors, not numbers.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from . import cracks, probe_metrics as pm, sections as secs, volume
+from . import cracks, errors, explosive, ledger, peaks, probe_metrics as pm, sections as secs
+from . import volume
 from .targets import TARGETS, verdict
 
 CRACK_SECTIONS = (secs.NAMED[0], secs.NAMED[2], secs.NAMED[4])
@@ -88,9 +93,9 @@ def _ppv_radius(ppv, profile) -> dict:
         if above[0]:
             k = int(np.argmin(above))
             return {"value_mm": float(d[k - 1] + 0.5 * (d[1] - d[0] if len(d) > 1 else 0)),
-                    "source": "frame profile (ring means; frames undersample the peak)"}
+                    "source": "peak_speed profile (ring means of |v| over every step)"}
         return {"not_available": "PPV is below 2.5 m/s already at the wall"}
-    return {"not_available": "no probes A-G and no v field"}
+    return {"not_available": "no probes A-G in the rock and no peak_speed field"}
 
 
 def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
@@ -114,19 +119,25 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
                "t_end_us": float(times[-1]) * 1e6, "pattern_frames": frames,
                "pattern_times_us": [float(times[k]) * 1e6 for k in frames],
                "sections_mm": {k: v * 1e3 for k, v in named.items()},
-               "radial_stress": radial, "wave_speed": pm.wave_speed(radial),
+               "radial_stress": radial, "wave_speed": pm.wave_speed(probes, radial),
                "ppv": pm.ppv(probes), "pressure_stress": pm.pressure_stress(probes),
-               "probes": {n: {"d_mm": p["d"] * 1e3, "gid": p["gid"]} for n, p in probes.items()}}
-    metrics.update({k: vol[k] for k in ("energy", "ppv_profile", "wall_pressure",
-                                        "wall_radial_stress", "gas_pressure", "failure_modes")})
+               "probes": {n: {"d_mm": p["d"] * 1e3, "gid": p["gid"], "part": p["part"],
+                              "material": p["material"],
+                              "requested_part": p.get("requested_part"),
+                              "snap_distance_mm": p["snap_distance_mm"], "error": p["error"]}
+                          for n, p in probes.items()}}
+    metrics.update({k: vol[k] for k in ("energy", "failure_modes", "frame_series")})
+    metrics.update(peaks.scan(run, model, probes))
+    metrics["explosive_reference"] = explosive.reference(model, metrics["gas_pressure"],
+                                                         metrics["wall_radial_stress"])
     metrics["gas_profiles"] = vol.get("gas_profiles", [])
     metrics["time_us"] = [t * 1e6 for t in vol["time_s"]]
-    metrics["global_energy_J"] = {k: run.energy(k).tolist() for k in
-                                  ("kinetic", "strain", "gas", "external", "total")
-                                  if run.has_energy(k)}
+    metrics["energy_ledger"] = ledger.read(run)
+    metrics["global_energy_J"] = metrics["energy_ledger"].get("series_J", {})
     fr = _fracture(sec_data, model, last) if run.root else None
     metrics["fracture"] = run.comm.bcast(fr, root=0)
     metrics["ppv_radius"] = _ppv_radius(metrics["ppv"], metrics["ppv_profile"])
+    metrics["errors"] = errors.collect(metrics, probes)
     metrics["targets"] = targets_table(metrics)
     data = {"sections": sec_data, "plane": plane, "probes": probes,
             "plane_frames": prof_frames} if run.root else None
@@ -139,13 +150,16 @@ def _point(block, name, key):
     for p in block.get("points", []):
         if p["name"] == name:
             return p[key]
+    for p in block.get("errors", []):
+        if p["name"] == name:
+            return {"error": f"probe {name}: {p['error']}"}
     return {"not_available": f"no probe {name}"}
 
 
 def _get(block, *keys):
     """``block[k1][k2]...``, or the first ``{"not_available": ...}`` met on the way."""
     for k in keys:
-        if isinstance(block, dict) and "not_available" in block:
+        if isinstance(block, dict) and ("not_available" in block or "error" in block):
             return block
         try:
             block = block[k]
@@ -164,6 +178,8 @@ def target_values(m: dict) -> dict:
         return y if isinstance(y, dict) else float(bool(y))
     return {
         "wave_speed": _get(m["wave_speed"], "speed_m_s"),
+        "wave_speed_peak": _get(m["wave_speed"].get("peak_arrival", m["wave_speed"]),
+                                "speed_m_s"),
         "peak_sigma_rr_A": _point(m["radial_stress"], "A", "peak_MPa"),
         "peak_sigma_rr_G": _point(m["radial_stress"], "G", "peak_MPa"),
         "attenuation_n": _get(m["radial_stress"], "fit", "n"),
@@ -172,8 +188,7 @@ def target_values(m: dict) -> dict:
         "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
         "ppv_radius_2p5": _get(m["ppv_radius"], "value_mm"),
         "peak_gas_pressure": _get(m["gas_pressure"], "peak_MPa"),
-        "peak_wall_pressure": _get(m["wall_radial_stress"] if "peak_MPa" in
-                                   m["wall_radial_stress"] else m["wall_pressure"], "peak_MPa"),
+        "peak_wall_pressure": _get(m["wall_radial_stress"], "peak_MPa"),
         "P1_yields": yields("P1"), "P2_yields": yields("P2"), "P3_yields": yields("P3"),
     }
 
@@ -183,15 +198,18 @@ def _bases(m: dict) -> dict:
     fr = m["fracture"]
     ns = len(fr.get("sections", {}))
     ws, rs = m["wave_speed"], m["radial_stress"]
+    pa = ws.get("peak_arrival", {})
     out = {"wave_speed": f"{len(ws['probes'])} probes" if "probes" in ws else "",
+           "wave_speed_peak": (f"{len(pa['probes'])} probes" if "probes" in pa else "")
+           + (f"; later pulse at {', '.join(pa['later_pulse'])}" if pa.get("later_pulse")
+              else ""),
            "attenuation_n": (f"{rs['fit']['n_points']} probes"
                              if "fit" in rs and "n_points" in rs["fit"] else ""),
            "major_radial_cracks": f"median of {ns} sections",
            "crushed_zone": f"mean of {ns} sections",
            "ppv_radius_2p5": m["ppv_radius"].get("source", ""),
-           "peak_gas_pressure": "saved frames",
-           "peak_wall_pressure": ("−σ_rr, saved frames" if "peak_MPa" in m["wall_radial_stress"]
-                                  else "mean pressure, saved frames")}
+           "peak_gas_pressure": m["gas_pressure"].get("basis", ""),
+           "peak_wall_pressure": m["wall_radial_stress"].get("basis", "")}
     out.update({f"crack_density_zone{k}": f"mean of {ns} sections" for k in (1, 2, 3)})
     return out
 
@@ -199,12 +217,17 @@ def _bases(m: dict) -> dict:
 def targets_table(m: dict) -> list[dict]:
     vals = target_values(m)
     bases = _bases(m)
+    ref = m["explosive_reference"]
+    bounds = {"peak_gas_pressure": tuple(ref["consistency_MPa"])
+              if "consistency_MPa" in ref else None}
+    band = {"peak_gas_pressure": explosive.band_text(ref)}
     rows = []
     for t in TARGETS:
         v = vals[t.key]
-        rows.append({"key": t.key, "label": t.label, "unit": t.unit,
+        rows.append({"key": t.key, "label": t.label, "unit": t.unit, "kind": t.kind,
                      "value": None if isinstance(v, dict) else float(v),
                      "basis": bases.get(t.key, "") if not isinstance(v, dict) else "",
-                     "paper": t.paper, "experiment": t.experiment, "band": t.band,
-                     "verdict": verdict(t.key, v)})
+                     "paper": t.paper, "experiment": t.experiment,
+                     "band": band.get(t.key, t.band),
+                     "verdict": verdict(t.key, v, bounds.get(t.key))})
     return rows

@@ -30,9 +30,13 @@ VIEWS = {"detonation-face": NAMED[0], "mid": NAMED[2], "far-face": NAMED[4]}
 
 def _cell(row) -> str:
     v = row["value"]
+    if row["verdict"].startswith("error"):
+        return "error"
     if v is None:
         return "n/a"
     shown = ("yes" if v else "no") if row["unit"] == "yes/no" else f"{v:.4g}"
+    if row["verdict"] == "information":
+        return shown
     return f"{shown} ({'in' if row['verdict'] == 'within' else 'out'})"
 
 
@@ -55,10 +59,13 @@ def render(runs) -> str:
         " / ".join(str(v) for k, v in list(r["failure_modes"].items())[1:4]) for r in runs)
         + " |")
     L.append("| peak energy in the rock (J) | | " + " | ".join(
-        "n/a" if "not_available" in r["energy"] else
+        "error" if "error" in r["energy"] else "n/a" if "not_available" in r["energy"] else
         f"{max(r['energy']['total_J'] or r['energy']['kinetic_J']):.4g}" for r in runs) + " |")
+    L.append("| errors (impossible values) | | " + " | ".join(
+        str(len(r["errors"])) for r in runs) + " |")
     L += ["", "'in' / 'out': within / outside the range of `postprocess/targets.py` (see a "
-          "run's report for the ranges).", "",
+          "run's report for the ranges); 'error': an impossible value (see the run's report).",
+          "",
           "![fracture](compare_fracture.png)", "", "![energy](compare_energy.png)", "",
           "![peak radial stress](compare_peak_stress.png)", ""]
     return "\n".join(L) + "\n"

@@ -2,10 +2,11 @@
 
 Fig. 12 crack density per zone beside the experiment's ranges; Fig. 15
 pressure–stress paths at P1–P3 with the JH2 envelopes; Fig. 16a radial stress
-histories at A–G; Fig. 16b arrival time of the peak against distance; Fig. 17
+histories at A–G; Fig. 16b first-arrival and peak-arrival times against distance; Fig. 17
 peak radial stress against distance (log–log, p = C d^-n); Fig. 18 PPV against
-distance (Holmberg–Persson); Fig. 7 explosive pressure along the borehole;
-Fig. 20 energy in the rock.  Radial stress is plotted compression-positive
+distance (Holmberg–Persson); Fig. 7 explosive pressure along the borehole, the
+every-step peaks and Table 2's p_CJ and p(1, e0); Fig. 20 energy in the rock and
+the run's energy ledger.  Radial stress is plotted compression-positive
 (-sigma_rr).
 """
 from __future__ import annotations
@@ -56,23 +57,45 @@ def radial_histories(probes, radial, label, out) -> str:
 
 
 def arrivals(ws, label, out) -> str:
+    """First arrivals (judged) and peak arrivals (the paper's method) against distance;
+    a fit line only where the speed is a number."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(5.2, 3.8))
+    fig, ax = plt.subplots(figsize=(5.6, 3.9))
     d = np.array([a["d_mm"] for a in ws["arrivals"]])
     t = np.array([a["t_us"] for a in ws["arrivals"]])
-    ax.plot(d, t, "o", label="peak arrival")
+    ax.plot(d, t, "o", color="C0", label="first arrival (10 % of the probe's peak)")
     for a in ws["arrivals"]:
         ax.annotate(a["name"], (a["d_mm"], a["t_us"]), textcoords="offset points", xytext=(4, -8))
-    dd = np.linspace(0, d.max() * 1.05, 50)
-    c = ws["speed_m_s"]
-    t0 = np.mean(t) - np.mean(d) / c * 1e3
-    ax.plot(dd, t0 + dd / c * 1e3, "-", label=f"fit: {c:.0f} m/s (R² {ws['r2']:.3f})")
-    ax.plot(dd, np.mean(t) + (dd - np.mean(d)) / 4535 * 1e3, ":", color="0.4",
-            label="4535 m/s (measured P wave), through the mean arrival")
+    pa = ws.get("peak_arrival", {})
+    if pa.get("arrivals"):
+        dp = np.array([a["d_mm"] for a in pa["arrivals"]])
+        tp = np.array([a["t_us"] for a in pa["arrivals"]])
+        late = set(pa.get("later_pulse", []))
+        mk = np.array([a["name"] in late for a in pa["arrivals"]])
+        ax.plot(dp[~mk], tp[~mk], "s", mfc="none", color="C2", label="peak arrival")
+        if mk.any():
+            ax.plot(dp[mk], tp[mk], "x", color="C3", label="peak arrival, a later pulse")
+    dd = np.linspace(0, max(d.max(), 1.0) * 1.05, 50) if len(d) else np.linspace(0, 1, 2)
+    if "speed_m_s" in ws:
+        c = ws["speed_m_s"]
+        t0 = np.mean(t) - np.mean(d) / c * 1e3
+        ax.plot(dd, t0 + dd / c * 1e3, "-", color="C0",
+                label=f"first arrivals: {c:.0f} m/s (R² {ws['r2']:.3f})")
+    if "speed_m_s" in pa:
+        c = pa["speed_m_s"]
+        tp0 = np.mean(tp) - np.mean(dp) / c * 1e3
+        ax.plot(dd, tp0 + dd / c * 1e3, "--", color="C2", lw=0.8,
+                label=f"peak arrivals: {c:.0f} m/s (information)")
+    if len(d):
+        ax.plot(dd, np.mean(t) + (dd - np.mean(d)) / 4535 * 1e3, ":", color="0.4",
+                label="4535 m/s (measured P wave), through the mean first arrival")
+    title = f"{label}: wave speed (cf. paper Fig. 16b)"
+    if "error" in ws:
+        title += "\nERROR: first arrivals do not increase with distance"
     ax.set_xlabel("distance from the borehole wall d (mm)")
-    ax.set_ylabel("arrival time of the peak (µs)")
-    ax.set_title(f"{label}: wave speed from peak arrivals (cf. paper Fig. 16b)")
-    ax.legend(fontsize=7)
+    ax.set_ylabel("arrival time (µs)")
+    ax.set_title(title, fontsize=8)
+    ax.legend(fontsize=6)
     fig.tight_layout()
     return save(fig, out)
 
@@ -121,7 +144,7 @@ def ppv(ppv_probes, profile, label, out) -> str:
         d = np.array(profile["d_mm"])
         ok = d > 0
         ax.loglog(d[ok], np.array(profile["mean_m_s"])[ok], "-", lw=0.8, color="0.3",
-                  label="ring mean over intact points, max over frames |v_r|")
+                  label="ring mean over intact points of peak |v|, every step")
         ax.loglog(d[ok], np.array(profile["max_m_s"])[ok], "--", lw=0.6, color="0.5",
                   label="ring max over intact points")
     for (lo, hi), txt, col in (((0.4, 0.8), "radial cracking", "C1"),
@@ -176,20 +199,32 @@ def explosive_pressure(m, label, out) -> str:
     a1.set_xlabel("z along the borehole (mm), detonation at z0")
     a1.set_ylabel("mean explosive pressure on the z level (MPa)")
     a1.set_title("explosive pressure along the borehole")
-    a1.legend(fontsize=7)
+    if m["gas_profiles"]:
+        a1.legend(fontsize=7)
     t = np.array(m["time_us"])
-    for key, txt in (("gas_pressure", "peak explosive pressure"),
-                     ("wall_radial_stress", "peak −σ_rr, rock wall layer"),
-                     ("wall_pressure", "peak mean pressure, rock wall layer")):
-        if "series_MPa" in m[key]:
-            a2.plot(t, m[key]["series_MPa"], "o-", ms=3, label=txt)
-    a2.axhline(1800, color="0.4", ls=":", lw=0.8, label="paper: 1800 MPa (gas)")
+    fs = m["frame_series"]
+    for key, txt, col in (("gas_pressure_MPa", "largest gas pressure", "C0"),
+                          ("wall_radial_stress_MPa", "largest −σ_rr, rock wall layer", "C1"),
+                          ("wall_pressure_MPa", "largest mean pressure, rock wall layer", "C2")):
+        if fs.get(key):
+            a2.plot(t, fs[key], "o-", ms=3, color=col, label=f"{txt} (saved frames)")
+    for key, txt, col in (("gas_pressure", "peak gas pressure, every step", "C0"),
+                          ("wall_radial_stress", "peak wall −σ_rr, every step", "C1")):
+        if "peak_MPa" in m[key]:
+            a2.axhline(m[key]["peak_MPa"], color=col, lw=1.2, label=txt)
+    ref = m["explosive_reference"]
+    if "p_CJ_MPa" in ref:
+        a2.axhline(ref["p_CJ_MPa"], color="k", ls="-.", lw=0.8,
+                   label=f"p_CJ = {ref['p_CJ_MPa']:.0f} MPa (Table 2)")
+        a2.axhline(ref["p_constant_volume_MPa"], color="k", ls=":", lw=0.8,
+                   label=f"p(1, e0) = {ref['p_constant_volume_MPa']:.0f} MPa (Table 2)")
+    a2.axhline(1800, color="0.4", ls=":", lw=0.8, label="paper: up to 1800 MPa (gas)")
     a2.axhline(1600, color="0.6", ls="--", lw=0.8, label="1600 MPa (FEM, wall)")
     a2.set_yscale("log")
     a2.set_xlabel("time after detonation (µs)")
-    a2.set_ylabel("pressure (MPa, saved frames)")
-    a2.set_title("peaks over the saved frames")
-    a2.legend(fontsize=7)
+    a2.set_ylabel("pressure (MPa)")
+    a2.set_title("histories at the saved frames; lines: peaks over every step", fontsize=8)
+    a2.legend(fontsize=6)
     fig.suptitle(f"{label}: explosive and borehole-wall pressure (cf. paper Fig. 7)")
     fig.tight_layout()
     return save(fig, out)
@@ -201,19 +236,29 @@ def energy(m, label, out) -> str:
     t = np.array(m["time_us"])
     e = m["energy"]
     a1.plot(t, e["kinetic_J"], label="kinetic")
-    if e.get("strain_J") is not None:
-        a1.plot(t, e["strain_J"], label="strain")
-        a1.plot(t, e["total_J"], "k-", lw=1.4, label="total (kinetic + strain)")
+    if e.get("elastic_J") is not None:
+        a1.plot(t, e["elastic_J"], label="elastic (recoverable)")
+        a1.plot(t, e["total_J"], "k-", lw=1.4, label="total (kinetic + elastic)")
     a1.set_xlabel("time after detonation (µs)")
     a1.set_ylabel("energy in the rock (J)")
-    a1.set_title("energy in the rock " + (f"({e['note']})" if e.get("note") else ""))
+    a1.set_title("energy in the rock " + (f"({e['note']})" if e.get("note") else ""),
+                 fontsize=7)
     a1.legend(fontsize=7)
+    led = m["energy_ledger"]
     for k, v in m["global_energy_J"].items():
-        a2.plot(t, v, label=k)
+        a2.plot(t[:len(v)], v, label=k)
+    bad = [x["measure"].split(": ")[1] for x in led.get("errors", [])]
     a2.set_xlabel("time after detonation (µs)")
     a2.set_ylabel("energy, whole model (J)")
-    a2.set_title("energy record of the run (/energy)")
-    a2.legend(fontsize=7)
+    a2.set_title("energy ledger of the run (/energy)"
+                 + (f"; not drawn (error): {', '.join(bad)}" if bad else ""), fontsize=8)
+    if led.get("balance") is not None:
+        ax3 = a2.twinx()
+        ax3.plot(t[:len(led["balance"])], led["balance"], "k:", lw=0.9, label="balance")
+        ax3.set_ylabel("relative closure error (balance)")
+        ax3.legend(fontsize=6, loc="lower right")
+    if m["global_energy_J"]:
+        a2.legend(fontsize=6, ncol=2)
     fig.suptitle(f"{label}: energy (cf. paper Fig. 20)")
     fig.tight_layout()
     return save(fig, out)
@@ -230,7 +275,7 @@ def compare_curves(entries, out_energy, out_stress) -> list[str]:
             y = e["total_J"] if e.get("total_J") is not None else e["kinetic_J"]
             ax.plot(m["time_us"], y, label=label + ("" if e.get("total_J") else " (kinetic)"))
     ax.set_xlabel("time after detonation (µs)")
-    ax.set_ylabel("energy in the rock, kinetic + strain (J)")
+    ax.set_ylabel("energy in the rock, kinetic + elastic (J)")
     ax.set_title("energy in the rock of each run (cf. paper Fig. 20)")
     ax.legend(fontsize=7)
     fig.tight_layout()

@@ -14,7 +14,15 @@ over the rock points (exact for the lattice of ``mpipd.geometry``: cell centres
 at half-integer multiples of dx).  Which fallback was used is in ``notes``.
 
 The rock is the part named ``rock``; else the part of a ``jh2`` material; else
-the largest part.  The charge is the part of a ``jwl`` material (or ``charge``).
+the largest part.  A rock split into zones (``<rock>.band``, ``<rock>.0``, ...;
+:meth:`mpipd.scene.Part.zones`) is all of them: ``rock_ids`` lists every zone,
+R_b is the innermost zone's inner radius, R_o the outermost zone's radius and
+``wall_dx`` the innermost zone's dx (the wall layer is r < R_b + wall_dx);
+``rock`` stays the zone of the sections and cracks (the one named ``rock``, or the
+first).  The charge is the part of a ``jwl`` material (or ``charge``);
+``explosive`` is its material (JWL constants, Table 2) when the scene parses.
+``peak_center`` is the axis of the run's ``peak_sigma_rr`` field (the scene's
+``[output] peak_center``, default (0, 0)).
 """
 from __future__ import annotations
 
@@ -52,12 +60,22 @@ class Model:
     jh2: object = None                           # the rock's JH2 material (or None)
     pressure_factor: float | None = None
     horizon: float | None = None                 # the rock's horizon (m); None -> 3 dx
+    rock_ids: tuple = ()                         # part indices of every zone of the rock
+    wall_dx: float | None = None                 # dx of the rock's innermost zone
+    explosive: object = None                     # the charge's JWL material (or None)
+    peak_center: tuple = (0.0, 0.0)              # axis of the peak_sigma_rr field
+    part_material: dict = field(default_factory=dict)   # part index -> material name
+    probe_parts: dict = field(default_factory=dict)     # probe name -> its scene ``part``
     overrides: list = field(default_factory=list)
     notes: list = field(default_factory=list)
 
     @property
     def thickness(self) -> float:
         return self.z1 - self.z0
+
+    def is_rock(self, pid: np.ndarray) -> np.ndarray:
+        """Mask of the points (part indices ``pid``) in any zone of the rock."""
+        return np.isin(pid, np.asarray(self.rock_ids or (self.rock,)))
 
     def radius(self, x: np.ndarray) -> np.ndarray:
         return np.hypot(x[:, 0] - self.center[0], x[:, 1] - self.center[1])
@@ -67,6 +85,8 @@ class Model:
                 "r_out_m": self.r_out, "z_m": [self.z0, self.z1], "dx_m": self.dx,
                 "horizon_m": self.horizon,
                 "rock_part": self.part_names[self.rock],
+                "rock_zones": [self.part_names[k] for k in self.rock_ids],
+                "wall_dx_m": self.wall_dx,
                 "charge_part": None if self.charge is None else self.part_names[self.charge],
                 "pressure_factor": self.pressure_factor, "overrides": self.overrides,
                 "notes": self.notes}
@@ -90,6 +110,17 @@ def _parse_scene(run, notes):
         notes.append(f"the stored scene does not parse ({' '.join(str(e).split())}): "
                      "geometry from the points")
         return None, sets
+
+
+def zone_of(name: str, part: str) -> bool:
+    """Is ``name`` the part ``part`` or one of its zones (``part.band``, ``part.0``, ...)?"""
+    return name == part or name.startswith(part + ".")
+
+
+def base_name(name: str) -> str:
+    """The part a zone belongs to: ``rock.band`` / ``rock.3`` -> ``rock``."""
+    head, _, tail = name.rpartition(".")
+    return head if head and (tail == "band" or tail.isdigit()) else name
 
 
 def _pick(names, models, want_name, want_model):
@@ -124,25 +155,36 @@ def load_model(run, label: str | None = None) -> Model:
         notes.append(f"no part named 'rock' or of a jh2 material: the largest part "
                      f"{parts[rock]!r} is taken as the rock")
     charge = _pick(parts, models, "charge", "jwl")
+    rock_base = base_name(parts[rock])
+    rock_ids = tuple(k for k, n in enumerate(parts) if zone_of(n, rock_base)) or (rock,)
     x = run.geometry("x")
-    sel = pid == rock
-    vol = run.geometry("volume")[sel]
+    sel = np.isin(pid, rock_ids)
+    vol = run.geometry("volume")[pid == rock]
     xr = x[sel]
     dx_geo = float(np.cbrt(run.max(float(vol.max()) if len(vol) else 0.0)))
-    shape = None
-    if scene is not None and parts[rock] in {p.name for p in scene.parts}:
-        spart = next(p for p in scene.parts if p.name == parts[rock])
+    shape, zones = None, []
+    sparts = {p.name: p for p in scene.parts} if scene is not None else {}
+    if parts[rock] in sparts:
+        spart = sparts[parts[rock]]
         shape = spart.shape
         dx = spart.dx
         horizon = spart.horizon
+        zones = [sparts[parts[k]] for k in rock_ids if parts[k] in sparts]
     else:
         dx = dx_geo
         horizon = 3.0 * dx
         notes.append("the rock's horizon is not known from the scene: 3 dx assumed")
-    if shape is not None and hasattr(shape, "inner_radius"):
+    wall_dx = dx
+    if shape is not None and all(hasattr(z.shape, "inner_radius") for z in zones):
+        inner = min(zones, key=lambda z: z.shape.inner_radius)
         center = (float(shape.center[0]), float(shape.center[1]))
-        r_wall, r_out = float(shape.inner_radius), float(shape.radius)
+        r_wall = float(inner.shape.inner_radius)
+        r_out = float(max(z.shape.radius for z in zones))
         z0, z1 = float(shape.z[0]), float(shape.z[1])
+        wall_dx = float(inner.dx)
+        if len(zones) > 1:
+            notes.append(f"the rock is {len(zones)} zones ({', '.join(z.name for z in zones)}): "
+                         f"sections and cracks use {parts[rock]!r} only (dx {dx * 1e3:g} mm)")
     else:
         if shape is not None:
             notes.append(f"the rock part is a {type(shape).__name__.lower()}, not an annulus: "
@@ -154,8 +196,11 @@ def load_model(run, label: str | None = None) -> Model:
         r_wall = run.min(float(r.min()) if len(r) else np.inf) - 0.5 * dx
         r_out = run.max(float(r.max()) if len(r) else 0.0) + 0.5 * dx
         z0, z1 = lo[2] - 0.5 * dx, hi[2] + 0.5 * dx
-    density, jh2, pf = {}, None, None
+    density, jh2, pf, explosive, probe_parts = {}, None, None, None, {}
+    peak_center = (0.0, 0.0)
     if scene is not None:
+        peak_center = tuple(float(c) for c in getattr(scene.output, "peak_center", (0.0, 0.0)))
+        probe_parts = {pr.name: getattr(pr, "part", None) for pr in scene.probes}
         for mid, name in enumerate(mats):
             if name in scene.materials:
                 density[mid] = float(scene.materials[name].density)
@@ -163,10 +208,13 @@ def load_model(run, label: str | None = None) -> Model:
         if rock_mat is not None and rock_mat.registry_name == "jh2":
             jh2 = rock_mat
         if charge is not None and part_mat.get(charge) in scene.materials:
-            pf = getattr(scene.materials[part_mat[charge]], "pressure_factor", None)
+            explosive = scene.materials[part_mat[charge]]
+            pf = getattr(explosive, "pressure_factor", None)
     name = str(run.attr("scene_name", scene.name if scene is not None else "unknown"))
     return Model(label=label or name, scene_name=name, center=center, r_wall=r_wall,
                  r_out=r_out, z0=z0, z1=z1, dx=float(dx), rock=rock, charge=charge,
                  part_names=parts, material_names=mats, density=density, jh2=jh2,
-                 pressure_factor=pf, horizon=float(horizon), overrides=sets, notes=notes)
+                 pressure_factor=pf, horizon=float(horizon), overrides=sets, notes=notes,
+                 rock_ids=rock_ids, wall_dx=float(wall_dx), explosive=explosive,
+                 peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts)
 

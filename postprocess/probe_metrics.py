@@ -1,17 +1,27 @@
 """Metrics from the probes, recorded every step (``/probes/<name>``, mpipd.probes).
 
 Probes A–G sit at 6.8, 10.8, 22, 29.2, 39.6, 50 and 59.6 mm from the borehole
-wall, P1–P3 at 0.8, 1.6 and 4.8 mm (paper Figs. 6, 15).  A probe's distance d
-is measured from its actual lattice point, d = |x - x_c| - R_b.
+wall, P1–P3 at 0.8, 1.6 and 4.8 mm (paper Figs. 6, 15), ``wall`` on the rock's
+first layer.  A probe's distance d is measured from its actual lattice point,
+d = |x - x_c| - R_b.
+
+A probe must sample the material it names.  A file written with the probe's part
+(``/probes/<name>`` attributes ``part``, ``requested_part``) is checked against
+``/geometry/part`` of the probe's gid; an older file against the ``part`` of the
+probe in the stored scene, and failing that the rock probes (wall, A–G, P1–P3)
+must be rock points.  A probe that fails carries ``error`` and gives no numbers.
 
 * Radial stress (Fig. 16a) and its attenuation (Fig. 17): the peak compressive
   radial stress p = max_t(-sigma_rr) at each of A–G, fitted with p = C d^-n
   (d in mm, p in MPa; paper: ~130 MPa at A, < 20 MPa at G, n = 0.798).  A probe
   whose peak is the last recorded step (the wave has not passed it yet) is shown
   but left out of the fits and of the wave speed.
-* Wave speed (Fig. 16b): the arrival time t_k of that peak at each of A–G (the
-  largest sample refined by a parabola); the slope of d against t is the speed
-  (paper 4270 m/s; measured P-wave speed 4535 m/s).
+* Wave speed (Fig. 16b): from the first arrivals at A–G (:mod:`postprocess.arrivals`:
+  10 % of each probe's peak, arrival times increasing with d, least-squares slope
+  of d against t; Table 1's c_P = sqrt((K + 4G/3)/rho) = 4595 m/s), and beside it the
+  paper's method, the arrival time of the peak (the largest sample refined by a
+  parabola; paper 4270 m/s, measured P-wave speed 4535 m/s), with the probes whose
+  peak is a later pulse than the first (a reflection) named.
 * PPV (Fig. 18): max_t |v_r| at each of A–G, fitted with the Holmberg–Persson
   law PPV = K d^-beta.
 * Pressure–stress paths (Fig. 15): (p, s) at P1–P3 against the JH2 strength
@@ -25,12 +35,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import fits
+from . import arrivals, fits
+from .model import zone_of
 
 SERIES = {"A": 6.8, "B": 10.8, "C": 22.0, "D": 29.2, "E": 39.6, "F": 50.0, "G": 59.6}
 PATHS = {"P1": 0.8, "P2": 1.6, "P3": 4.8}
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
 YIELD_TOL = 0.99
+ROCK_PROBES = ("wall", *SERIES, *PATHS)
 
 
 def na(reason: str) -> dict:
@@ -55,9 +67,39 @@ def load_probes(run, model) -> dict:
             x = run.f["geometry/x"][gid]
             data.update(gid=gid, x=x.tolist(),
                         d=float(np.hypot(x[0] - model.center[0], x[1] - model.center[1])
-                                - model.r_wall))
+                                - model.r_wall), **_placement(run, model, name, g, gid))
             out[name] = data
     return run.comm.bcast(out, root=0)
+
+
+def _attr(g, key):
+    v = g.attrs.get(key)
+    return v.decode() if isinstance(v, bytes) else (None if v is None else str(v))
+
+
+def _placement(run, model, name, g, gid) -> dict:
+    """Part and material of the probe's point (from the geometry), the part it should
+    be in, and ``error`` if it is not there."""
+    pid = int(run.f["geometry/part"][gid])
+    mid = int(run.f["geometry/material"][gid])
+    part = model.part_names[pid] if pid < len(model.part_names) else str(pid)
+    mat = model.material_names[mid] if mid < len(model.material_names) else str(mid)
+    dist = g.attrs.get("distance")
+    info = {"part": part, "material": mat,
+            "snap_distance_mm": None if dist is None else float(dist) * 1e3, "error": None}
+    want = _attr(g, "requested_part") if "requested_part" in g.attrs else None
+    if want is None:
+        want = model.probe_parts.get(name)
+    if want:
+        info["requested_part"] = want
+        if not zone_of(part, want):
+            info["error"] = (f"its point (gid {gid}) is in part {part!r} (material {mat}), "
+                             f"not in part {want!r}")
+    elif name in ROCK_PROBES and pid not in model.rock_ids:
+        rock = model.part_names[model.rock]
+        info["error"] = (f"its point (gid {gid}) is in part {part!r} (material {mat}), not a "
+                         f"rock point ({rock!r}); the probe names no part")
+    return info
 
 
 def _series(probes, names):
@@ -66,9 +108,17 @@ def _series(probes, names):
     return have, missing
 
 
+def _bad(probes, names) -> list[dict]:
+    """The probes that fail their placement check: shown as errors, never as numbers."""
+    return [{"name": n, "error": probes[n]["error"]} for n in names
+            if n in probes and probes[n].get("error")]
+
+
 def radial_stress(probes) -> dict:
     have, missing = _series(probes, SERIES)
-    if not have:
+    bad = _bad(probes, have)
+    have = [n for n in have if not probes[n].get("error")]
+    if not have and not bad:
         return na("no probes named A-G with recorded steps")
     pts = []
     for n in have:
@@ -76,7 +126,7 @@ def radial_stress(probes) -> dict:
         t, pk, interior = fits.peak_time(q["t"], -q["sigma_rr"])
         pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": SERIES[n],
                     "peak_MPa": pk / 1e6, "t_peak_us": t * 1e6, "peak_inside_record": interior})
-    out = {"points": pts, "missing": missing}
+    out = {"points": pts, "missing": missing, "errors": bad}
     out["fit"] = _fit([p for p in pts if p["peak_inside_record"]], "peak_MPa")
     out["excluded_from_fit"] = [p["name"] for p in pts if not p["peak_inside_record"]]
     return out
@@ -91,32 +141,69 @@ def _fit(pts, key) -> dict:
         return na(f"{e} (probes whose peak is at the end of the record are left out)")
 
 
-def wave_speed(radial: dict) -> dict:
+def wave_speed(probes, radial: dict) -> dict:
+    """First-arrival speed over A–G (judged), with the paper's peak-arrival speed beside
+    it (``peak_arrival``, information)."""
     if "points" not in radial:
         return na(radial["not_available"])
-    pts = [p for p in radial["points"] if p["peak_inside_record"]]
     late = [p["name"] for p in radial["points"] if not p["peak_inside_record"]]
+    pts = [p for p in radial["points"] if p["peak_inside_record"]]
+    rows, skipped = [], {}
+    for p in pts:
+        q = probes[p["name"]]
+        a = arrivals.first_arrival(q["t"], -q["sigma_rr"])
+        if "not_available" in a:
+            skipped[p["name"]] = a["not_available"]
+            continue
+        rows.append({"name": p["name"], "d_mm": p["d_mm"], "t_us": a["t_s"] * 1e6,
+                     "threshold_MPa": a["threshold_Pa"] / 1e6, "t_peak_us": p["t_peak_us"],
+                     "first_pulse_end_us": a["first_pulse_end_s"] * 1e6,
+                     "peak_in_first_pulse": a["peak_in_first_pulse"]})
+    later = [r["name"] for r in rows if not r["peak_in_first_pulse"]]
+    out = {"method": "first arrival", "threshold": arrivals.THRESHOLD_TEXT,
+           "probes": [r["name"] for r in rows], "arrivals": rows,
+           "excluded_peak_at_record_end": late, "excluded_no_arrival": skipped,
+           "probe_errors": radial.get("errors", [])}
+    fit = arrivals.speed([r["name"] for r in rows], [r["d_mm"] * 1e-3 for r in rows],
+                         [r["t_us"] * 1e-6 for r in rows])
+    if "speed_m_s" in fit:
+        out.update(speed_m_s=fit["speed_m_s"], r2=fit["r2"])
+    else:
+        out.update(fit)
+        if "not_available" in fit:
+            out["not_available"] += f"; peaks at the end of the record: {', '.join(late) or 'none'}"
+    out["peak_arrival"] = _peak_arrival(pts, later)
+    return out
+
+
+def _peak_arrival(pts, later) -> dict:
+    """The paper's method: slope of d against the arrival time of each probe's peak."""
+    note = ("peak is a later pulse than the first (a reflection): " + ", ".join(later)
+            if later else "every probe's peak lies in its first pulse")
     try:
         f = fits.line([p["t_peak_us"] * 1e-6 for p in pts], [p["d_mm"] * 1e-3 for p in pts])
     except fits.FitError as e:
-        return na(f"{e}; peaks at the end of the record: {', '.join(late) or 'none'}")
+        return {"not_available": str(e), "later_pulse": later, "note": note}
     return {"speed_m_s": f["slope"], "r2": f["r2"], "probes": [p["name"] for p in pts],
-            "excluded_peak_at_record_end": late,
+            "later_pulse": later, "note": note,
             "arrivals": [{"name": p["name"], "d_mm": p["d_mm"], "t_us": p["t_peak_us"]}
                          for p in pts]}
 
 
 def ppv(probes) -> dict:
     have, missing = _series(probes, SERIES)
+    bad = _bad(probes, have)
+    have = [n for n in have if not probes[n].get("error")]
     if not have:
-        return na("no probes named A-G with recorded steps")
+        return na("no probes named A-G with recorded steps" + (
+            f" in the rock ({', '.join(b['name'] for b in bad)}: error)" if bad else ""))
     pts = []
     for n in have:
         a = np.abs(probes[n]["v_r"])
         k = int(np.argmax(a))
         pts.append({"name": n, "d_mm": probes[n]["d"] * 1e3, "ppv_m_s": float(a[k]),
                     "peak_inside_record": 0 < k < len(a) - 1})
-    out = {"points": pts, "missing": missing, "source": "probes (every step)"}
+    out = {"points": pts, "missing": missing, "errors": bad, "source": "probes (every step)"}
     out["fit"] = _fit([p for p in pts if p["peak_inside_record"]], "ppv_m_s")
     out["excluded_from_fit"] = [p["name"] for p in pts if not p["peak_inside_record"]]
     return out
@@ -133,7 +220,9 @@ def jh2_envelope(jh2, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def pressure_stress(probes) -> dict:
     have, missing = _series(probes, PATHS)
-    if not have:
+    bad = _bad(probes, have)
+    have = [n for n in have if not probes[n].get("error")]
+    if not have and not bad:
         return na("no probes named P1-P3 with recorded steps")
     pts = []
     for n in have:
@@ -150,4 +239,4 @@ def pressure_stress(probes) -> dict:
                     "s_at_yield_MPa": None if first is None else float(q["s"][first]) / 1e6,
                     "failed_at_us": float(q["t"][failed[0]]) * 1e6 if len(failed) else None,
                     "strength_recorded": bool(np.isfinite(st).any())})
-    return {"points": pts, "missing": missing}
+    return {"points": pts, "missing": missing, "errors": bad}

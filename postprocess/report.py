@@ -50,8 +50,8 @@ def _figures(metrics, data, model, times, label, out: Path) -> tuple[dict, dict]
     put("fig16a_radial_stress", rs.get("not_available"), fc.radial_histories, data["probes"], rs,
         label, out / "fig16a_radial_stress.png")
     ws = metrics["wave_speed"]
-    put("fig16b_wave_speed", ws.get("not_available"), fc.arrivals, ws, label,
-        out / "fig16b_wave_speed.png")
+    put("fig16b_wave_speed", ws.get("not_available") if not ws.get("arrivals") else None,
+        fc.arrivals, ws, label, out / "fig16b_wave_speed.png")
     put("fig17_peak_radial_stress", rs.get("not_available"), fc.peak_stress, rs, label,
         out / "fig17_peak_radial_stress.png")
     pv, prof = metrics["ppv"], metrics["ppv_profile"]
@@ -60,14 +60,17 @@ def _figures(metrics, data, model, times, label, out: Path) -> tuple[dict, dict]
     ps = metrics["pressure_stress"]
     put("fig15_pressure_stress", ps.get("not_available"), fc.pressure_stress, data["probes"], ps,
         model.jh2, label, out / "fig15_pressure_stress.png")
-    gp = metrics["gas_pressure"]
-    put("fig07_explosive_pressure", gp.get("not_available"), fc.explosive_pressure, metrics,
-        label, out / "fig07_explosive_pressure.png")
+    fs = metrics["frame_series"]
+    has_gas = metrics["gas_profiles"] or any(fs[k] for k in fs if k != "note")
+    put("fig07_explosive_pressure", None if has_gas else "the run has no pressure or stress field",
+        fc.explosive_pressure, metrics, label, out / "fig07_explosive_pressure.png")
     plane = data["plane"]
     put("fig07_pressure_plane", None if plane is not None else "the run has no pressure field",
         fmap.plane_pressure, plane, model, times, data["plane_frames"], label,
         out / "fig07_pressure_plane.png")
-    put("fig20_rock_energy", metrics["energy"].get("not_available"), fc.energy, metrics, label,
+    en = metrics["energy"]
+    put("fig20_rock_energy", en.get("not_available") or
+        (f"error: {en['error']}" if "error" in en else None), fc.energy, metrics, label,
         out / "fig20_rock_energy.png")
     return made, skipped
 
@@ -93,7 +96,8 @@ def make_report(path, out, comm, pattern_us=None) -> list[str]:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     made, skipped = _figures(metrics, data, model, times, label, out)
-    doc = {"run": info, "figures": made, "figures_not_made": skipped, **metrics}
+    doc = {"run": info, "errors": metrics["errors"], "figures": made,
+           "figures_not_made": skipped, **metrics}
     (out / "report.json").write_text(json.dumps(doc, indent=1, default=_json) + "\n")
     from .report_md import render
     (out / "report.md").write_text(render(doc))

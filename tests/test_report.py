@@ -40,7 +40,7 @@ dx = {DX}
 shape = {{ kind = "annulus", center = [0.0, 0.0], inner_radius = {R_WALL}, radius = {R_OUT}, z = [0.0, {NZ * DX}] }}
 [output]
 every = 250
-fields = ["v", "damage", "failure_mode", "pressure", "strain_energy"]
+fields = ["v", "damage", "failure_mode", "pressure"]
 """
 PROBES = {"A": 6.8, "B": 10.8, "C": 22.0, "D": 26.0, "P1": 0.8, "P2": 1.6, "P3": 4.8}
 
@@ -63,11 +63,31 @@ def gaussian(t, t0, width):
     return np.exp(-((t - t0) / width) ** 2)
 
 
-def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5):
+LEDGER = ("t", "kinetic", "integrator", "elastic", "plastic", "hourglass", "spring", "contact",
+          "gas", "removed", "viscous", "damping", "gas_damping", "interface", "external",
+          "initial", "balance")
+# the every-step peaks at the last frame (synthetic, known): gas 7 GPa x (1 + z/100 mm),
+# rock -sigma_rr 1 GPa (R_b / r)^2 and p 0.6 of it, speed 10 / (1 + d/mm) m/s
+GAS_PEAK = 7.0e9
+
+
+def peak_values(x, part):
+    r = np.hypot(x[:, 0], x[:, 1])
+    rock = part == 1
+    srr = np.where(rock, 1e9 * (R_WALL / r) ** 2, 0.0)
+    p = np.where(rock, 0.6 * srr, GAS_PEAK * (1 + x[:, 2] * 10.0))
+    speed = np.where(rock, 10.0 / (1.0 + (r - R_WALL) * 1e3), 0.0)
+    return p, srr, speed
+
+
+def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5, legacy=False):
     """An mpipd-layout run file.  ``failed``: boolean mask (last frame damage = 1);
-    v = (v_rock * k, 0, 0) m/s and W = w_rock * k J/m3 on the rock at frame k;
-    explosive pressure 1e8 * (k + 1) * (1 + z/mm) Pa; probes carry a Gaussian pulse
-    of peak C d^-n (d in mm) arriving at d / C_WAVE."""
+    v = (v_rock * k, 0, 0) m/s and elastic energy w_rock * k J/m3 on the rock at frame k;
+    explosive pressure 1e8 * (k + 1) * (1 + z/mm) Pa at the saved frames; probes carry a
+    Gaussian pulse of peak C d^-n (d in mm) arriving at d / C_WAVE.  The current layout
+    has the every-step peak fields (:func:`peak_values` at the last frame, rising to it),
+    the energy ledger and the probes' part attributes; ``legacy=True`` writes the layout
+    before them (``strain_energy`` = w_rock * k, /energy/{strain, total}, no peaks)."""
     x, part = lattice()
     N = len(x)
     rock = part == 1
@@ -95,20 +115,33 @@ def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5):
         v = np.zeros((frames, N, 3))
         v[:, rock, 0] = v_rock * k
         fl["v"] = v
-        fl["strain_energy"] = np.where(rock[None, :], w_rock * k, 0.0)
+        fl["strain_energy" if legacy else "stress_work"] = np.where(rock[None, :], w_rock * k, 0.)
         fl["pressure"] = np.where(rock[None, :], 0.0, 1e8 * (k + 1) * (1 + x[None, :, 2] * 1e3))
         e = f.create_group("energy")
-        for name in ("t", "kinetic", "strain", "hourglass", "gas", "total", "external"):
-            e[name] = np.zeros(frames)
+        if legacy:
+            for name in ("t", "kinetic", "strain", "hourglass", "gas", "total", "external"):
+                e[name] = np.zeros(frames)
+        else:
+            fl["elastic_energy"] = np.where(rock[None, :], w_rock * k, 0.0)
+            rise = (k + 1) / frames
+            for name, a in zip(("peak_pressure", "peak_sigma_rr", "peak_speed"),
+                               peak_values(x, part)):
+                fl[name] = rise * a[None, :]
+            for name in LEDGER:
+                e[name] = np.zeros(frames)
         r = np.hypot(x[:, 0], x[:, 1])
         for name, d_mm in PROBES.items():
             want = np.array([R_WALL + d_mm * 1e-3, 0.0, 0.5 * NZ * DX])
-            gid = int(np.argmin(np.where(rock, np.linalg.norm(x - want, axis=1), np.inf)))
+            dist = np.where(rock, np.linalg.norm(x - want, axis=1), np.inf)
+            gid = int(np.argmin(dist))
             d = r[gid] - R_WALL
             pulse = gaussian(t, 1e-6 + d / C_WAVE, 0.4e-6)
             pg = f.create_group(f"probes/{name}")
             pg.attrs["gid"] = gid
             pg.attrs["position"] = want
+            if not legacy:
+                pg.attrs.update(x=x[gid], distance=dist[gid], part="rock", material="granite",
+                                requested_part="rock")
             pg["t"] = t
             pg["sigma_rr"] = -C_ATT * (d * 1e3) ** -N_ATT * pulse
             pg["v_r"] = 5.0 * (d * 1e3) ** -1.2 * pulse
@@ -117,6 +150,27 @@ def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5):
             pg["s"] = 100e6 * pulse
             pg["strength"] = np.where(yielding, 100e6, 500e6) * np.ones_like(t)
     return x, part
+
+
+def put_probe(path, name, gid, sigma_rr, t=None, part=None):
+    """Replace (or add) probe ``name`` at ``gid`` with record -sigma_rr = ``-sigma_rr``;
+    ``part`` -> the part attributes of the current layout (None: a legacy probe)."""
+    with h5py.File(path, "r+") as f:
+        if f"probes/{name}" in f:
+            del f[f"probes/{name}"]
+        t = np.arange(len(sigma_rr)) * DT if t is None else t
+        pg = f.create_group(f"probes/{name}")
+        pg.attrs["gid"] = gid
+        pg.attrs["position"] = f["geometry/x"][gid]
+        if part is not None:
+            names = [n.decode() if isinstance(n, bytes) else n
+                     for n in f["geometry/part"].attrs["names"]]
+            pg.attrs.update(x=f["geometry/x"][gid], distance=0.0, requested_part=part,
+                            part=names[int(f["geometry/part"][gid])], material="")
+        pg["t"] = t
+        pg["sigma_rr"] = sigma_rr
+        for q in ("v_r", "p", "s", "strength"):
+            pg[q] = np.zeros_like(t)
 
 
 def analyse(path):
@@ -211,7 +265,8 @@ def test_wave_speed_attenuation_and_ppv_from_probes(tmp_path):
     assert rs["fit"]["C"] == pytest.approx(C_ATT / 1e6, rel=1e-3)
     a = rs["points"][0]
     assert a["peak_MPa"] == pytest.approx(C_ATT / 1e6 * a["d_mm"] ** -N_ATT, rel=1e-4)
-    assert m["wave_speed"]["speed_m_s"] == pytest.approx(C_WAVE, rel=1e-3)
+    assert m["wave_speed"]["speed_m_s"] == pytest.approx(C_WAVE, rel=1e-3)       # first arrival
+    assert m["wave_speed"]["peak_arrival"]["speed_m_s"] == pytest.approx(C_WAVE, rel=1e-3)
     assert m["ppv"]["fit"]["n"] == pytest.approx(1.2, abs=1e-4)
     assert m["ppv"]["source"].startswith("probes")
     row = {r["key"]: r for r in m["targets"]}
@@ -220,6 +275,8 @@ def test_wave_speed_attenuation_and_ppv_from_probes(tmp_path):
 
 
 def test_energy_paths_and_pressures(tmp_path):
+    """The energy in the rock is kinetic + elastic_energy (not stress work); the paths'
+    yield points; the gas profile at the saved frames."""
     x, part = lattice()
     write_run(tmp_path / "run.h5", v_rock=2.0, w_rock=3.0)
     m, _ = analyse(tmp_path / "run.h5")
@@ -231,12 +288,289 @@ def test_energy_paths_and_pressures(tmp_path):
     ps = {p["name"]: p for p in m["pressure_stress"]["points"]}
     assert ps["P1"]["yielded"] and ps["P2"]["yielded"] and not ps["P3"]["yielded"]
     assert ps["P1"]["s_at_yield_MPa"] == pytest.approx(99.0, abs=1.0)
-    gas = m["gas_pressure"]
-    zmax = (NZ - 0.5)                                           # mm, top level
-    assert gas["peak_MPa"] == pytest.approx(100 * 5 * (1 + zmax))
     prof = m["gas_profiles"][-1]
     np.testing.assert_allclose(prof["p_MPa"], 100 * 5 * (1 + np.array(prof["z_mm"])))
     assert m["failure_modes"]["intact"] == int((part == 1).sum())
+    assert m["errors"] == []
+
+
+def test_rock_energy_without_elastic_energy_is_kinetic_only(tmp_path):
+    """A file with only strain_energy (stress work, elastic + plastic): kinetic energy
+    only, with the note — the stress work is never counted as energy in the rock."""
+    x, part = lattice()
+    write_run(tmp_path / "run.h5", v_rock=2.0, w_rock=3.0, legacy=True)
+    m, _ = analyse(tmp_path / "run.h5")
+    n_rock = int((part == 1).sum())
+    k = np.arange(5)
+    np.testing.assert_allclose(m["energy"]["kinetic_J"],
+                               n_rock * DX ** 3 * 0.5 * 2660.0 * (2.0 * k) ** 2, rtol=1e-12)
+    assert m["energy"]["total_J"] is None and m["energy"]["elastic_J"] is None
+    assert "kinetic energy only" in m["energy"]["note"]
+    assert m["energy_ledger"]["layout"].startswith("pre-ledger")
+
+
+def jwl_reference():
+    """Table 2's p(1, e0) and p_CJ computed here from the JWL formula (independently
+    of mpipd): p_CJ = rho0 D_CJ^2 (1 - V) at the V of the smallest Rayleigh-line D on
+    the products' Hugoniot from (V = 1, p = 0, e = e0), by brute force over V."""
+    A, B, R1, R2, w, e0, rho = 568e9, 21.6e9, 5.81, 1.77, 0.282, 7.38e9, 1320.0
+
+    def f(V):
+        return A * (1 - w / (R1 * V)) * np.exp(-R1 * V) + B * (1 - w / (R2 * V)) * np.exp(-R2 * V)
+    p_cv = f(1.0) + w * e0
+    V = np.linspace(0.5, 0.99, 200001)
+    pH = (f(V) + w * e0 / V) / (1 - w * (1 - V) / (2 * V))
+    D2 = pH / (rho * (1 - V))
+    j = int(np.argmin(D2))
+    return p_cv, pH[j]
+
+
+def test_peaks_over_every_step_from_the_peak_fields(tmp_path):
+    """The peaks come from the last frame of the peak fields, not from the saved frames
+    (whose gas pressure reaches only 2250 MPa): gas 7 GPa (1 + z/100 mm) at the top
+    level; the wall layer's -sigma_rr 1 GPa (R_b/r)^2 at its innermost point; the PPV
+    profile the ring means of 10/(1 + d/mm) over intact rock points."""
+    x, part = lattice()
+    r = np.hypot(x[:, 0], x[:, 1])
+    rock = part == 1
+    write_run(tmp_path / "run.h5")
+    m, _ = analyse(tmp_path / "run.h5")
+    zmax = (NZ - 0.5) * DX
+    gas = m["gas_pressure"]
+    assert gas["peak_MPa"] == pytest.approx(GAS_PEAK * (1 + zmax * 10.0) / 1e6, rel=1e-12)
+    assert gas["basis"] == "every step"
+    wall = rock & (r < R_WALL + DX)
+    srr = 1e9 * (R_WALL / r[wall]) ** 2
+    ws = m["wall_radial_stress"]
+    assert ws["peak_MPa"] == pytest.approx(srr.max() / 1e6, rel=1e-12)
+    assert ws["layer_mean_MPa"] == pytest.approx(srr.mean() / 1e6, rel=1e-12)
+    assert ws["points"] == int(wall.sum()) and ws["basis"] == "every step"
+    assert m["wall_pressure"]["peak_MPa"] == pytest.approx(0.6 * srr.max() / 1e6, rel=1e-12)
+    prof = m["ppv_profile"]
+    d = r[rock] - R_WALL
+    sp = 10.0 / (1.0 + d * 1e3)
+    b = np.clip((d / DX).astype(int), 0, int(np.ceil((R_OUT - R_WALL) / DX)) - 1)
+    for dm, mean in zip(prof["d_mm"], prof["mean_m_s"]):
+        ring = b == int(dm)                        # ring k is centred on (k + 1/2) mm
+        assert mean == pytest.approx(sp[ring].mean(), rel=1e-12)
+    # the gas row: a consistency check between p(1, e0) and p_CJ, computed
+    p_cv, p_cj = jwl_reference()
+    ref = m["explosive_reference"]
+    assert ref["p_constant_volume_MPa"] == pytest.approx(p_cv / 1e6, rel=1e-9)
+    assert ref["p_CJ_MPa"] == pytest.approx(p_cj / 1e6, rel=1e-4)
+    assert 15.0e3 < ref["p_CJ_MPa"] < 16.0e3 and 6.7e3 < ref["p_constant_volume_MPa"] < 6.9e3
+    row = {r["key"]: r for r in m["targets"]}
+    g = row["peak_gas_pressure"]
+    assert g["verdict"] == "within" and g["basis"] == "every step"
+    assert "consistency" in g["band"] and "p_CJ" in g["band"] and "1800" not in g["band"]
+    assert row["peak_wall_pressure"]["verdict"] == "information"
+    assert row["peak_wall_pressure"]["value"] == pytest.approx(srr.max() / 1e6)
+
+
+def test_peak_gas_pressure_above_p_cj_is_outside(tmp_path):
+    write_run(tmp_path / "run.h5")
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/peak_pressure"][-1] = np.where(f["geometry/part"][...] == 0, 20e9, 0.0)
+    m, _ = analyse(tmp_path / "run.h5")
+    row = {r["key"]: r for r in m["targets"]}["peak_gas_pressure"]
+    assert row["value"] == pytest.approx(20e3) and row["verdict"] == "outside"
+
+
+def test_peaks_without_peak_fields(tmp_path):
+    """No peak fields: the gas peak comes from the peak_gas_pressure attribute, else it
+    is not available; the wall from the every-step wall probe, else not available; no
+    PPV profile.  Never the saved frames."""
+    x, part = lattice()
+    path = tmp_path / "run.h5"
+    write_run(path, legacy=True)
+    m, _ = analyse(path)
+    for key in ("gas_pressure", "wall_radial_stress", "wall_pressure", "ppv_profile"):
+        assert "not_available" in m[key] and "peak" in m[key]["not_available"], key
+    row = {r["key"]: r for r in m["targets"]}
+    assert row["peak_gas_pressure"]["verdict"].startswith("not available")
+    r = np.hypot(x[:, 0], x[:, 1])
+    first = int(np.flatnonzero((part == 1) & (r < R_WALL + DX))[0])
+    srr = -np.concatenate([np.linspace(0, 3e8, 300), np.linspace(3e8, 1e8, 701)])
+    put_probe(path, "wall", first, srr)
+    with h5py.File(path, "r+") as f:
+        f.attrs["peak_gas_pressure"] = 8.1e9
+    m, _ = analyse(path)
+    assert m["gas_pressure"]["peak_MPa"] == pytest.approx(8100.0)
+    assert m["gas_pressure"]["source"].endswith("attribute")
+    ws = m["wall_radial_stress"]
+    assert ws["peak_MPa"] == pytest.approx(300.0) and ws["source"].startswith("wall probe")
+    assert m["errors"] == []
+
+
+def half_sine(t, t0, width, amp):
+    s = np.sin(np.pi * (t - t0) / width)
+    return np.where((t > t0) & (t < t0 + width), amp * s, 0.0)
+
+
+C_P = math.sqrt((21.9e9 + 4 * 25.7e9 / 3) / 2660.0)      # Table 1: 4595 m/s
+
+
+def series_gids(x, part, dists_mm):
+    """Rock gids on the +x row y = dx/2 at mid-thickness nearest each distance."""
+    r = np.hypot(x[:, 0], x[:, 1])
+    row = (part == 1) & (np.abs(x[:, 1] - 0.5 * DX) < 1e-9) & (x[:, 0] > 0) \
+        & (np.abs(x[:, 2] - 1.5 * DX) < 1e-9)
+    idx = np.flatnonzero(row)
+    gids = [int(idx[np.argmin(np.abs(r[idx] - R_WALL - dm * 1e-3))]) for dm in dists_mm]
+    return gids, r[gids] - R_WALL
+
+
+def put_series(path, arrivals_fn, names="ABCDEFG", dists_mm=(4, 7, 10, 13, 17, 21, 25)):
+    """Probes A-G on rock points at ``dists_mm`` carrying ``arrivals_fn(name, d, t)``."""
+    x, part = lattice()
+    gids, d = series_gids(x, part, dists_mm)
+    t = np.arange(1501) * DT
+    for n, g, dd in zip(names, gids, d):
+        put_probe(path, n, g, -arrivals_fn(n, dd, t), t=t, part="rock")
+    return dict(zip(names, d))
+
+
+def test_first_arrival_gives_the_p_wave_speed(tmp_path):
+    """Half-sine pulses leave the wall at t0 and travel at c_P = 4595 m/s (Table 1),
+    attenuated, each followed by a later pulse: at B, D and F it is 1.5 x the first
+    (a reflection carrying the global peak), elsewhere half of it.  The arrival at 10 %
+    of each probe's peak is, for a half-sine of width T and a global-to-first peak
+    ratio q, t0 + d/c_P + T/pi asin(0.1 q); the speed is the least-squares line
+    through those (within 2 % of c_P), while the peak arrivals are thrown off."""
+    path = tmp_path / "run.h5"
+    write_run(path)
+    T, t0, q = 2e-6, 0.5e-6, 1.5
+    reflected = {"B", "D", "F"}
+
+    def pulse(n, d, t):
+        amp = 300e6 * (d * 1e3) ** -0.8
+        y = half_sine(t, t0 + d / C_P, T, amp)
+        late = t0 + d / C_P + T + 0.3e-6                      # after the first pulse
+        return y + half_sine(t, late, 1e-6, q * amp if n in reflected else 0.5 * amp)
+    d = put_series(path, pulse)
+    m, _ = analyse(path)
+    ws = m["wave_speed"]
+    assert ws["threshold"].startswith("10 %")
+    for a in ws["arrivals"]:
+        qq = q if a["name"] in reflected else 1.0
+        want = t0 + d[a["name"]] / C_P + T / math.pi * math.asin(0.1 * qq)
+        assert a["t_us"] == pytest.approx(want * 1e6, abs=2e-5)       # 0.02 ns
+    # arrival offsets differ between the reflected and the other probes: the expected
+    # slope is the least-squares line through the expected arrivals, computed here
+    names = sorted(d)
+    te = [t0 + d[n] / C_P + T / math.pi * math.asin(0.1 * (q if n in reflected else 1.0))
+          for n in names]
+    want_speed = np.polyfit(te, [d[n] for n in names], 1)[0]
+    assert ws["speed_m_s"] == pytest.approx(want_speed, rel=1e-5)
+    assert ws["speed_m_s"] == pytest.approx(C_P, rel=0.02)
+    pa = ws["peak_arrival"]
+    assert sorted(pa["later_pulse"]) == sorted(reflected)
+    assert "B" in pa["note"] and "reflection" in pa["note"]
+    assert abs(pa["speed_m_s"] - C_P) > 0.1 * C_P                # the peaks are misleading
+    row = {r["key"]: r for r in m["targets"]}
+    assert row["wave_speed"]["verdict"] == "within"
+    assert row["wave_speed"]["value"] == pytest.approx(ws["speed_m_s"])
+    assert row["wave_speed_peak"]["verdict"] == "information"
+    assert m["errors"] == []
+
+
+def test_first_arrival_of_a_clean_wave_is_exact(tmp_path):
+    """Equal pulse shapes (no later pulse): every arrival is t0 + d/c_P + T/pi asin(0.1),
+    and the speed is c_P."""
+    path = tmp_path / "run.h5"
+    write_run(path)
+    T, t0 = 2e-6, 0.5e-6
+    d = put_series(path, lambda n, d, t: half_sine(t, t0 + d / C_P, T, 200e6 / (d * 1e3)))
+    m, _ = analyse(path)
+    ws = m["wave_speed"]
+    assert len(ws["arrivals"]) == 7 and ws["peak_arrival"]["later_pulse"] == []
+    assert ws["speed_m_s"] == pytest.approx(C_P, rel=1e-5)
+    off = T / math.pi * math.asin(0.1)
+    for a in ws["arrivals"]:
+        assert a["t_us"] == pytest.approx((t0 + d[a["name"]] / C_P + off) * 1e6, abs=2e-5)
+
+
+def test_arrivals_out_of_order_are_an_error(tmp_path):
+    """C's pulse arrives before B's: no wave speed, an error in the Errors section at the
+    top of report.md and in report.json, and the targets row shows 'error'."""
+    from mpi4py import MPI
+
+    from postprocess.report import make_report
+    path = tmp_path / "run.h5"
+    write_run(path)
+
+    def pulse(n, d, t):
+        arrive = 3e-6 + d / C_P - (2.5e-6 if n == "C" else 0.0)
+        return half_sine(t, arrive, 2e-6, 100e6)
+    put_series(path, pulse)
+    m, _ = analyse(path)
+    ws = m["wave_speed"]
+    assert "speed_m_s" not in ws and "do not increase" in ws["error"] and "C" in ws["error"]
+    rows = {r["key"]: r for r in m["targets"]}
+    row = rows["wave_speed"]
+    assert row["value"] is None and row["verdict"].startswith("error")
+    assert rows["wave_speed_peak"]["verdict"] == "information"      # shown, not judged
+    assert [e["measure"] for e in m["errors"]] == ["wave speed (first arrivals)"]
+    make_report(path, tmp_path / "rep", MPI.COMM_SELF)
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert md.index("## Errors") < md.index("## Targets")
+    assert "first-arrival times do not increase" in md.split("## Targets")[0]
+    assert "| **error** |" in md
+    doc = json.loads((tmp_path / "rep" / "report.json").read_text())
+    assert doc["errors"] == m["errors"]
+
+
+def test_probe_outside_its_part_is_an_error(tmp_path):
+    """A probe that names the rock but sits on a charge point (current layout), and an
+    older file's wall probe on a charge point (no part attribute): errors, no numbers."""
+    x, part = lattice()
+    path = tmp_path / "run.h5"
+    write_run(path)
+    gas_gid = int(np.flatnonzero(part == 0)[0])
+    put_probe(path, "A", gas_gid, -np.linspace(0, 1e8, 1001), part="rock")
+    m, _ = analyse(path)
+    assert m["probes"]["A"]["error"] and "'charge'" in m["probes"]["A"]["error"]
+    assert "A" not in [p["name"] for p in m["radial_stress"]["points"]]
+    row = {r["key"]: r for r in m["targets"]}["peak_sigma_rr_A"]
+    assert row["value"] is None and row["verdict"].startswith("error")
+    assert "probe A" in [e["measure"] for e in m["errors"]]
+    write_run(path, legacy=True)
+    put_probe(path, "wall", gas_gid, -np.linspace(0, 1e8, 1001))
+    m, _ = analyse(path)
+    assert "not a rock point" in m["probes"]["wall"]["error"]
+    assert "error" in m["wall_radial_stress"]
+    assert [e["measure"] for e in m["errors"]] == ["probe wall"]
+
+
+def test_negative_energies_are_errors(tmp_path):
+    """A negative kinetic term of the ledger and a negative elastic energy in the rock
+    (larger than its kinetic energy) are errors; the other ledger terms and the largest
+    |balance| are reported."""
+    from mpi4py import MPI
+
+    from postprocess.report import make_report
+    path = tmp_path / "run.h5"
+    write_run(path, v_rock=0.0, w_rock=-1.0)
+    with h5py.File(path, "r+") as f:
+        e = f["energy"]
+        e["kinetic"][...] = [0.0, 5.0, -2.0, 3.0, 1.0]
+        e["elastic"][...] = [0.0, 1.0, 2.0, 3.0, 4.0]
+        e["initial"][...] = 10.0
+        e["balance"][...] = [0.0, 1e-4, -3e-3, 2e-3, 1e-3]
+    m, _ = analyse(path)
+    assert "error" in m["energy"] and "negative" in m["energy"]["error"]
+    led = m["energy_ledger"]
+    assert "error" in led["final_J"]["kinetic"] and led["final_J"]["elastic"] == 4.0
+    assert led["max_abs_balance"] == pytest.approx(3e-3) and led["max_abs_balance_frame"] == 2
+    assert "kinetic" not in led["series_J"]
+    assert sorted(e["measure"] for e in m["errors"]) == ["energy in the rock (Fig. 20)",
+                                                         "energy ledger: kinetic"]
+    make_report(path, tmp_path / "rep", MPI.COMM_SELF)
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert "| kinetic | **error**" in md and "| elastic | 4 |" in md
+    assert "Largest |balance|" in md and "0.003 at frame 2" in md
+    assert "fig20_rock_energy" not in json.loads((tmp_path / "rep" / "report.json").read_text()
+                                                 )["figures"]
 
 
 def post(ranks, *args, timeout=120):
@@ -275,6 +609,20 @@ def test_foreign_and_truncated_files_are_one_line_errors(tmp_path):
                           "--out", str(tmp_path / "cmp")], capture_output=True, text=True,
                          timeout=60, cwd=ROOT, env=child_env())
     assert res.returncode == 2 and "not an mpipd run file" in res.stderr
+
+
+def test_every_step_peaks_and_ledger_are_the_same_on_1_and_2_reading_ranks(tmp_path):
+    """The peak fields, the wall layer, the PPV profile and the ledger reduce per z level
+    and by MAX: report.json is identical on 1 and 2 reading ranks."""
+    write_run(tmp_path / "run.h5", v_rock=1.5, w_rock=0.7)
+    docs = []
+    for n in (1, 2):
+        res = post(n, "report", str(tmp_path / "run.h5"), "--out", str(tmp_path / f"r{n}"))
+        assert res.returncode == 0, res.stderr
+        docs.append((tmp_path / f"r{n}" / "report.json").read_text())
+    assert docs[0] == docs[1]
+    doc = json.loads(docs[0])
+    assert doc["gas_pressure"]["basis"] == "every step" and "mean_m_s" in doc["ppv_profile"]
 
 
 def test_compare_puts_runs_side_by_side(tmp_path):
@@ -335,7 +683,21 @@ def test_report_on_blast_demo_under_mpirun(demo_run, tmp_path):
     for name in doc["figures"].values():
         assert (tmp_path / "rep2" / name).stat().st_size > 10_000
     md = (tmp_path / "rep2" / "report.md").read_text()
-    assert "| quantity | this run |" in md and len(doc["targets"]) == 15
-    assert all(r["verdict"].split(":")[0] in ("within", "outside", "not available")
+    # 16 rows: the peak-arrival wave speed is shown beside the judged first-arrival one
+    assert "| quantity | this run |" in md and len(doc["targets"]) == 16
+    assert all(r["verdict"].split(":")[0] in ("within", "outside", "not available",
+                                              "information", "error")
                for r in doc["targets"])
+    # every probe of the built-in blast scenes names the rock and samples a rock point
+    with h5py.File(demo_run, "r") as f:
+        names = [n.decode() if isinstance(n, bytes) else n
+                 for n in f["geometry/part"].attrs["names"]]
+        for name, g in f["probes"].items():
+            assert g.attrs["requested_part"] == "rock" and g.attrs["material"] == "granite"
+            assert names[int(f["geometry/part"][g.attrs["gid"]])] == "rock" == g.attrs["part"]
+            want = np.asarray(g.attrs["position"])
+            assert g.attrs["distance"] == pytest.approx(
+                np.linalg.norm(f["geometry/x"][g.attrs["gid"]] - want))
+    assert not [e for e in doc["errors"] if e["measure"].startswith("probe")]
+    assert md.index("## Errors") < md.index("## Targets")
     shutil.rmtree(tmp_path / "rep1")

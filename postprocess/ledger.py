@@ -1,0 +1,59 @@
+"""The run's energy ledger, ``/energy/<term>`` (J, one value per frame).
+
+Terms: held = kinetic + integrator + elastic + hourglass + spring + contact + gas;
+dissipated = plastic + removed + viscous + damping + gas_damping + interface;
+the books close as initial + external = held + dissipated, and ``balance`` is the
+relative closure error (initial + external - held - dissipated) / scale.
+
+The report reads whichever terms the file has (older files: kinetic, strain, gas,
+total, external, hourglass), gives the final value of each and the largest
+|balance|.  A term that must be non-negative (``NON_NEGATIVE``) going below
+-1e-9 of the ledger's scale (the largest magnitude of any J term at any frame)
+is an error: it is reported as such and its values are not shown as numbers.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
+DISSIPATED = ("plastic", "removed", "viscous", "damping", "gas_damping", "interface")
+BOOKS = ("initial", "external")
+TERMS = HELD + DISSIPATED + BOOKS
+NON_NEGATIVE = ("kinetic", "elastic", "plastic", "hourglass", "spring", "contact", "gas",
+                "viscous", "damping", "gas_damping")
+OLD = ("strain", "total")          # the layout before the ledger
+TOL = 1e-9
+
+
+def read(run) -> dict:
+    """Collective (every rank reads the small /energy datasets): the ledger block."""
+    names = [k for k in (*TERMS, *OLD) if run.has_energy(k)]
+    if not names and not run.has_energy("balance"):
+        return {"not_available": "the run file has no /energy group"}
+    series = {k: np.asarray(run.energy(k), float) for k in names}
+    scale = max((float(np.abs(v).max()) for v in series.values() if len(v)), default=0.0)
+    errors, final = [], {}
+    for k, v in series.items():
+        low = int(np.argmin(v)) if len(v) else 0
+        if k in NON_NEGATIVE and len(v) and v[low] < -TOL * scale:
+            errors.append({"measure": f"energy ledger: {k}",
+                           "message": f"{k} energy is negative ({v[low]:.4g} J at frame {low}); "
+                                      "it must be >= 0"})
+            final[k] = {"error": f"negative ({v[low]:.4g} J at frame {low})"}
+        else:
+            final[k] = float(v[-1]) if len(v) else None
+    out = {"terms": [k for k in names], "final_J": final, "errors": errors,
+           "layout": "ledger" if any(k in TERMS for k in names) and "strain" not in names
+           else "pre-ledger (/energy/strain, /energy/total)"}
+    bad = {e["measure"].split(": ")[1] for e in errors}
+    out["series_J"] = {k: v.tolist() for k, v in series.items() if k not in bad}
+    if run.has_energy("balance"):
+        b = np.asarray(run.energy("balance"), float)
+        ok = np.isfinite(b).any()
+        k = int(np.nanargmax(np.abs(b))) if ok else 0
+        out["balance"] = b.tolist()
+        out["max_abs_balance"] = float(abs(b[k])) if ok else None
+        out["max_abs_balance_frame"] = k
+    else:
+        out["max_abs_balance"] = None
+    return out
