@@ -99,8 +99,8 @@ class Correspondence:
         p, fam = self.points, self.families
         if which is None:
             which = np.arange(p.n_owned, dtype=np.int64)
-        nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
+        nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                           fam.broken, self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
         self.spring[self.not_tl] = 3
         self.n_spring = self.count_spring()
         return self.n_spring
@@ -111,9 +111,9 @@ class Correspondence:
 
     def deform(self, u, v):
         p, fam = self.points, self.families
-        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
-                                   self.dil)
+        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets,
+                                   fam.nbr, fam.broken, self.Kinv, self.spring, self.F,
+                                   self.Fdot, self.dil)
 
     def rotate(self, dt: float):
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
@@ -142,8 +142,8 @@ class Correspondence:
 
     def gather(self, u, v, f):
         p, fam = self.points, self.families
-        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.fd, self.cbb, self.contact, f)
+        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                           fam.broken, self.fd, self.cbb, self.contact, f)
 
     def commit(self):
         self.F_old[...] = self.F
@@ -174,5 +174,5 @@ class Correspondence:
 
     def hourglass_energy(self, u) -> float:
         p, fam = self.points, self.families
-        return nosb.hourglass_energy(p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                     fam.broken, self.F, self.fd, self.spring)
+        return nosb.hourglass_energy(p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
+                                     fam.nbr, fam.broken, self.F, self.fd, self.spring)
