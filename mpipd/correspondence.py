@@ -114,13 +114,13 @@ class Correspondence:
         if which is None:
             which = np.arange(p.n_owned, dtype=np.int64)
         before = self.spring[which] == 0
-        nosb.shape_tensors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
+        nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                           fam.broken, self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
         self.spring[self.not_tl] = 3
         if u is not None and len(which):
             Fn = np.empty((len(which), 3, 3))
-            nosb.gradients_of(which, p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
-                              fam.broken, self.Kinv, self.spring, Fn)
+            nosb.gradients_of(which, p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
+                              fam.nbr, fam.broken, self.Kinv, self.spring, Fn)
             j_old = np.linalg.det(self.F[which])
             j_new = np.linalg.det(Fn)
             ok = before & (self.spring[which] == 0) & (j_old > 0) & (j_new > 0)
@@ -136,9 +136,9 @@ class Correspondence:
 
     def deform(self, u, v):
         p, fam = self.points, self.families
-        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
-                                   self.dil)
+        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets,
+                                   fam.nbr, fam.broken, self.Kinv, self.spring, self.F,
+                                   self.Fdot, self.dil)
 
     def initial_volume(self):
         """J_end = c det F of the current F (the start of a run, before any step)."""
@@ -177,8 +177,8 @@ class Correspondence:
     def gather(self, u, v, f, fv):
         """Internal force density into f; the viscous share also into fv (if any)."""
         p, fam = self.points, self.families
-        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                           self.fd, self.cbb, self.contact, f, fv)
+        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                           fam.broken, self.fd, self.cbb, self.contact, f, fv)
 
     def commit(self):
         self.F_old[...] = self.F
@@ -218,9 +218,9 @@ class Correspondence:
         (kernels.energy)."""
         p, fam = self.points, self.families
         out = np.empty((len(rows), 3))
-        energy.point_potentials(rows, p.x, u, p.volume, p.horizon, fam.offsets, fam.nbr,
-                                fam.broken, self.F, self.hg_modulus, self.trK, self.spring,
-                                self.cbb, self.contact, out)
+        energy.point_potentials(rows, p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
+                                fam.nbr, fam.broken, self.F, self.hg_modulus, self.trK,
+                                self.spring, self.cbb, self.contact, out)
         return out
 
     def hourglass_energy(self, u) -> float:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import LayerTable, fill_layers
+from .kernels.influence import CODES as INFLUENCE
 
 
 class DecompositionError(ValueError):
@@ -160,6 +161,7 @@ class Points:
     volume: np.ndarray          # (n_local,)
     horizon: np.ndarray         # (n_local,)
     dx: np.ndarray              # (n_local,) local lattice spacing
+    influence: np.ndarray       # (n_local,) uint8 influence-function code (kernels.influence)
     n_owned: int
 
     @property
@@ -180,6 +182,7 @@ def local_points(scene, slabs: Slabs, r: int) -> Points:
         volume=dx ** 3,
         horizon=np.array([p.horizon for p in scene.parts])[part],
         dx=dx,
+        influence=np.array([INFLUENCE[p.influence] for p in scene.parts], dtype=np.uint8)[part],
         n_owned=int(slabs.table.count[a:b].sum()),
     )
 

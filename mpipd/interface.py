@@ -9,12 +9,14 @@ P the force density on point i is
     f_i = P g_i,   g_i = sum_j (omega_i K_i^-1 + omega_j K_j^-1) xi_ij V_j,
 
 and g_i, zero by symmetry inside a uniform lattice, is of order 1/dx within
-two horizons of a change of spacing or horizon (a coarse/fine interface, the
-zones of a graded part).  That is a ghost force: a uniform strain across the
+two horizons of a change of spacing, horizon or influence function (a
+coarse/fine interface, the zones of a graded part, two parts with different
+``influence``).  That is a ghost force: a uniform strain across the
 interface is not in equilibrium.
 
 The correction (this module) acts on points whose g_i can feel a change of
-resolution (a family member of another dx or horizon, or one that has one):
+resolution (a family member of another dx, horizon or influence function, or
+one that has one):
 
 * in full where the ball of twice the point's reach lies inside the
   total-Lagrangian body — there the uniform-stress force is pure artefact;
@@ -57,9 +59,10 @@ G_TOL = 1e-12
 
 
 def needed(scene, tl_parts) -> bool:
-    """A correction exists only if the total-Lagrangian parts differ in dx or horizon."""
+    """A correction exists only if the total-Lagrangian parts differ in dx, horizon
+    or influence function."""
     return (scene.solver.interface_correction
-            and len({(p.dx, p.horizon) for p in tl_parts}) > 1)
+            and len({(p.dx, p.horizon, p.influence) for p in tl_parts}) > 1)
 
 
 class InterfaceCorrection:
@@ -75,8 +78,8 @@ class InterfaceCorrection:
         near = self._near_interface(p, fam, halo)
         cand = np.flatnonzero(tl[:n] & (corr.spring == 0) & near).astype(np.int64)
         g = np.zeros((len(cand), 3))
-        kern.interface_vectors(p.x, p.volume, p.horizon, fam.offsets, fam.nbr, fam.broken,
-                               kinv, cand, g)
+        kern.interface_vectors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                               fam.broken, kinv, cand, g)
         sel = np.linalg.norm(g, axis=1) * p.dx[cand] > G_TOL
         cand, g = cand[sel], g[sel]
         reach = self._reach(p.horizon, fam, cand)
@@ -97,11 +100,11 @@ class InterfaceCorrection:
 
     @staticmethod
     def _near_interface(p, fam, halo) -> np.ndarray:
-        """Owned points whose g_i can feel a change of dx or horizon: a family
-        member of another resolution, or a family member that has one."""
+        """Owned points whose g_i can feel a change of dx, horizon or influence
+        function: a family member of another one, or a family member that has one."""
         n = p.n_owned
         mixed = np.zeros(p.n_local, dtype=np.uint8)
-        kern.mixed_families(p.dx, p.horizon, fam.offsets, fam.nbr, n, mixed)
+        kern.mixed_families(p.dx, p.horizon, p.influence, fam.offsets, fam.nbr, n, mixed)
         halo.exchange(mixed)
         near = np.zeros(n, dtype=np.uint8)
         kern.spread(mixed, fam.offsets, fam.nbr, n, near)

@@ -71,6 +71,23 @@ class UniformVelocity:
         v[self.region.contains(x)] += np.asarray(self.velocity)
 
 
+@INITIAL.register("gaussian_velocity")
+@dataclass(frozen=True)
+class GaussianVelocity:
+    """v = velocity * exp(-|x - center|^2 / (2 sigma^2)) at every point: a smooth
+    3-D bump of peak ``velocity`` (m/s) and width ``sigma`` (m) about ``center`` (m)."""
+    center: tuple[float, float, float]
+    sigma: float
+    velocity: tuple[float, float, float]
+
+    def check(self, path):
+        positive(self, path, "sigma")
+
+    def apply(self, x: np.ndarray, v: np.ndarray) -> None:
+        s2 = np.sum((x - np.asarray(self.center)) ** 2, axis=1)
+        v += np.exp(-0.5 * s2 / self.sigma ** 2)[:, None] * np.asarray(self.velocity)[None, :]
+
+
 @INITIAL.register("radial_velocity")
 @dataclass(frozen=True)
 class RadialVelocity:

@@ -41,7 +41,8 @@ from .geometry import LayerTable
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
-BYTES_PER_LOCAL_POINT = 209     # x, gid, part, material, volume, horizon, dx, u, v, fd, cbb, mode
+BYTES_PER_LOCAL_POINT = 210     # x, gid, part, material, volume, horizon, dx, influence, u, v,
+#                                 fd, cbb, mode
 BYTES_PER_OWNED_POINT = 666     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
 #                                 index, volume factor, fallback toggles, ledger row index
@@ -189,7 +190,7 @@ def check_report(scene, ranks: int) -> str:
         fam = len(bulk_family(p.dx, p.horizon))
         out.append(f"  part {p.name!r}: {p.shape.registry_name}, material {p.material!r} "
                    f"({mat.registry_name}), dx = {p.dx:.4g} m, horizon = {p.horizon:.4g} m "
-                   f"({p.horizon_factor:g} dx), {npts} points, "
+                   f"({p.horizon_factor:g} dx), influence {p.influence}, {npts} points, "
                    + ("updated-Lagrangian gas: families re-found every step, held on every rank"
                       if is_gas_part(scene, p) else
                       f"{nb} bonds ({nb / max(npts, 1):.1f} per point, {fam} in the bulk)"))

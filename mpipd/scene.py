@@ -6,9 +6,10 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [time]        dt (s) and exactly one of steps / t_end (s)
     [materials.NAME]  model = "elastic", density, bulk_modulus, shear_modulus
     [[parts]]     name, material, dx (m), horizon_factor (default 3.0),
-                  shape = { kind = "box" | "cylinder" | "annulus", ... }
+                  shape = { kind = "box" | "cylinder" | "annulus", ... },
+                  influence = "quadratic" (default) | "constant" | "inverse"
     [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every
-    [[initial]]   kind = "velocity_pulse" | "uniform_velocity", ...
+    [[initial]]   kind = "velocity_pulse" | "uniform_velocity" | "gaussian_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
     [[probes]]    name, position, center (radial axis), part (snap to that part's
@@ -21,6 +22,11 @@ default factor 3 the lattice shell at exactly |xi| = 3 dx is included (122
 neighbours in the bulk, like the peer codes' 3.015 dx) robustly against
 round-off, while the influence function omega = (delta - |xi|)^2 stays the
 paper's.
+
+Influence function.  A part's ``influence`` picks omega for its points'
+side of every bond (mpipd.kernels.influence): "quadratic" (delta - |xi|)^2, the
+paper's and the default; "constant" 1, Peridigm's default; "inverse"
+delta / |xi|.  Graded rings and an inner band inherit it.
 
 Bad input raises :class:`mpipd.schema.SceneError` with one line naming the key.
 """
@@ -36,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from .geometry import SHAPES
+from .kernels.influence import CODES as INFLUENCE
 from .loads import BOUNDARIES, INITIAL, LOADS
 from .materials import MATERIALS
 from .probes import Probe, part_matches
@@ -130,9 +137,13 @@ class Part:
     horizon_factor: float = 3.0
     grade: Grade | None = None
     band: Band | None = None
+    influence: str = "quadratic"
 
     def check(self, path):
         positive(self, path, "dx")
+        if self.influence not in INFLUENCE:
+            fail(join(path, "influence"), f"unknown influence function {self.influence!r} "
+                                          f"(known: {', '.join(INFLUENCE)})")
         if not self.horizon_factor >= 1.0:
             fail(join(path, "horizon_factor"),
                  f"horizon must be at least dx (factor >= 1, got {self.horizon_factor})")
@@ -270,6 +281,9 @@ class Scene:
                      f"no material {p.material!r} (defined: {', '.join(self.materials)})")
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
+            if p.influence != "quadratic" and getattr(self.materials[p.material], "is_gas", False):
+                fail(f"parts[{i}].influence", "the explosive gas (updated-Lagrangian) always "
+                                              "uses the quadratic influence function")
             names.add(p.name)
         gas = [m for m, mat in self.materials.items() if getattr(mat, "is_gas", False)]
         if len(gas) > 1:

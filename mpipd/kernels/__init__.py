@@ -2,6 +2,8 @@
 only arrays and scalars.  One concern per module:
 
 ``linalg``     3x3 helpers (determinant, inverse, products) on small arrays
+``influence``  the influence functions omega (quadratic, constant, inverse) and
+               their per-point codes
 ``nosb``       shape tensor K, deformation gradient F and its rate, force data,
                the force gather (correspondence force state + hourglass penalty
                + bond-spring fallback)

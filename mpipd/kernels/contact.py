@@ -5,7 +5,8 @@
 a pair force density (per V_i V_j), repulsive only while the pair is closer than
 in the reference configuration.  The paper writes the influence function omega
 here, which leaves Eq. 40 without consistent units; mpipd uses its
-dimensionless form omegahat = omega / delta^2 = (1 - |xi|/delta)^2.  For a pair
+dimensionless form omegahat = omega / delta^2 = (1 - |xi|/delta)^2, whatever
+influence function the parts use (mpipd.kernels.influence).  For a pair
 of points with different horizons or moduli, c_s and delta are the pair's
 means, so the force is equal and opposite.
 """

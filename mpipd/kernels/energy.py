@@ -24,16 +24,17 @@ import math
 
 import numba
 
-from .nosb import influence
+from .influence import influence
 
 
 @numba.njit(cache=True)
-def point_potentials(rows, x, u, vol, horizon, offsets, nbr, broken, F, hg_modulus, trK,
-                     spring, cbb, contact, out):
+def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg_modulus,
+                     trK, spring, cbb, contact, out):
     """out[p] = (hourglass, spring, contact) energy (J) owned by point rows[p]."""
     for p in range(rows.shape[0]):
         i = rows[p]
         di = horizon[i]
+        ci = infl[i]
         code = spring[i]
         h = 2.0 * hg_modulus[i] / trK[i] if code == 0 and trK[i] > 0.0 else 0.0
         ehg = 0.0
@@ -57,7 +58,7 @@ def point_potentials(rows, x, u, vol, horizon, offsets, nbr, broken, F, hg_modul
                         cs = 0.5 * (cbb[i] + cbb[j])
                         eco += 0.5 * cs * w * w * (ly - r) ** 2 / (2.0 * delta) * vol[j]
                 continue
-            wi = influence(di, r)
+            wi = influence(ci, di, r)
             if wi == 0.0:
                 continue
             if code == 0:

@@ -5,19 +5,20 @@ dual horizons) on point i is P g_i with the purely geometric vector
 
     g_i = sum_j (omega_i K_i^-1 + omega_j K_j^-1) xi_ij V_j ,
 
-which vanishes by symmetry inside a uniform lattice but not where horizons
-and spacings change.  The correction subtracts P_i g_i = A_i q_i at the chosen
+(omega_i with point i's influence function and horizon, omega_j with j's; see
+mpipd.kernels.influence), which vanishes by symmetry inside a uniform lattice
+but not where horizons, spacings or influence functions change.  The correction subtracts P_i g_i = A_i q_i at the chosen
 points, with A_i = P_i K_i^-1 = B_i + h_i F_i (the force data) and q_i = K_i g_i.
 """
 import math
 
 import numba
 
-from .nosb import influence
+from .influence import influence
 
 
 @numba.njit(cache=True)
-def interface_vectors(x, vol, horizon, offsets, nbr, broken, kinv, points, g):
+def interface_vectors(x, vol, horizon, infl, offsets, nbr, broken, kinv, points, g):
     """g_i (1/m) of the owned points in ``points``.  ``kinv`` (n_local, 10) holds
     K^-1 row-major and, in column 9, 1.0 for a point without one (bond-spring
     fallback or not total-Lagrangian): such neighbours contribute nothing."""
@@ -25,6 +26,7 @@ def interface_vectors(x, vol, horizon, offsets, nbr, broken, kinv, points, g):
         i = points[p]
         g0 = g1 = g2 = 0.0
         di = horizon[i]
+        ci = infl[i]
         own = kinv[i, 9] == 0.0
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
@@ -35,12 +37,12 @@ def interface_vectors(x, vol, horizon, offsets, nbr, broken, kinv, points, g):
             e2 = x[j, 2] - x[i, 2]
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
             vj = vol[j]
-            wi = influence(di, r) * vj if own else 0.0
+            wi = influence(ci, di, r) * vj if own else 0.0
             if wi > 0.0:
                 g0 += wi * (kinv[i, 0] * e0 + kinv[i, 1] * e1 + kinv[i, 2] * e2)
                 g1 += wi * (kinv[i, 3] * e0 + kinv[i, 4] * e1 + kinv[i, 5] * e2)
                 g2 += wi * (kinv[i, 6] * e0 + kinv[i, 7] * e1 + kinv[i, 8] * e2)
-            wj = influence(horizon[j], r) * vj
+            wj = influence(infl[j], horizon[j], r) * vj
             if wj > 0.0 and kinv[j, 9] == 0.0:
                 g0 += wj * (kinv[j, 0] * e0 + kinv[j, 1] * e1 + kinv[j, 2] * e2)
                 g1 += wj * (kinv[j, 3] * e0 + kinv[j, 4] * e1 + kinv[j, 5] * e2)
@@ -105,13 +107,14 @@ def family_reach(horizon, offsets, nbr, idx, out):
 
 
 @numba.njit(cache=True)
-def mixed_families(dx, horizon, offsets, nbr, n_owned, out):
-    """out[i] = 1 for owned i whose family holds a point of another dx or horizon."""
+def mixed_families(dx, horizon, infl, offsets, nbr, n_owned, out):
+    """out[i] = 1 for owned i whose family holds a point of another dx, horizon
+    or influence function."""
     for i in range(n_owned):
         hit = 0
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
-            if dx[j] != dx[i] or horizon[j] != horizon[i]:
+            if dx[j] != dx[i] or horizon[j] != horizon[i] or infl[j] != infl[i]:
                 hit = 1
                 break
         out[i] = hit

@@ -1,7 +1,15 @@
 """Correspondence (non-ordinary state-based) kernels, gather form.
 
 Notation (paper §2.1): xi = x_j - x_i (reference bond), Y = xi + u_j - u_i
-(deformed bond), omega_i = (delta_i - |xi|)^2 for |xi| < delta_i, else 0.
+(deformed bond), omega_i = omega(|xi|) with point i's influence function and
+horizon delta_i (mpipd.kernels.influence; ``infl`` holds every local point's
+code, ghosts included), zero for |xi| >= delta_i:
+
+      quadratic (default, the paper's)  omega = (delta - |xi|)^2
+      constant  (Peridigm's default)    omega = 1
+      inverse                           omega = delta / |xi|
+
+omega_j of the same bond always uses point j's function and horizon.
 
 * Shape tensor (Eq. 4):    K_i = sum_j omega_i xi (x) xi V_j
 * Deformation gradient (Eq. 5) and its rate (Eq. 13):
@@ -29,30 +37,25 @@ import numba
 import numpy as np
 
 from .contact import contact_force
+from .influence import influence
 from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
 from .viscosity import viscous_bond
 
 
 @numba.njit(cache=True, inline="always")
-def influence(delta, r):
-    """omega = (delta - r)^2 inside the horizon, 0 outside."""
-    w = delta - r
-    return w * w if w > 0.0 else 0.0
-
-
-@numba.njit(cache=True, inline="always")
-def bond(x, i, j, delta):
-    """Reference bond xi = x_j - x_i, |xi| and omega_i (no volume)."""
+def bond(x, i, j, code, delta):
+    """Reference bond xi = x_j - x_i, |xi| and omega_i (no volume), for point i's
+    influence ``code`` and horizon ``delta``."""
     e0 = x[j, 0] - x[i, 0]
     e1 = x[j, 1] - x[i, 1]
     e2 = x[j, 2] - x[i, 2]
     r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    return e0, e1, e2, r, influence(delta, r)
+    return e0, e1, e2, r, influence(code, delta, r)
 
 
 @numba.njit(cache=True)
-def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, gamma, spring, rcond,
-                  points):
+def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma, spring,
+                  rcond, points):
     """K^-1, tr K and gamma = sum_j omega V_j (Eq. 43) for the owned points in ``points``.
 
     A point with fewer than 3 intact bonds, or with det K <= rcond (tr K / 3)^3,
@@ -66,10 +69,11 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, gamma, sprin
         g = 0.0
         nb = 0
         di = horizon[i]
+        ci = infl[i]
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
-            e0, e1, e2, r, w = bond(x, i, nbr[b], di)
+            e0, e1, e2, r, w = bond(x, i, nbr[b], ci, di)
             if w == 0.0:
                 continue
             w *= vol[nbr[b]]
@@ -104,8 +108,8 @@ def shape_tensors(x, vol, horizon, offsets, nbr, broken, Kinv, trK, gamma, sprin
 
 
 @numba.njit(cache=True)
-def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spring, F, Fdot,
-                          dil):
+def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kinv, spring, F,
+                          Fdot, dil):
     """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v.  If ``dil``
     has rows, also dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
     want_dil = dil.shape[0] > 0
@@ -126,6 +130,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
         vi0, vi1, vi2 = v[i, 0], v[i, 1], v[i, 2]
         di = horizon[i]
+        ci = infl[i]
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
@@ -134,7 +139,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
             e1 = x[j, 1] - xi1
             e2 = x[j, 2] - xi2
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = influence(di, r) * vol[j]
+            w = influence(ci, di, r) * vol[j]
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
@@ -177,7 +182,7 @@ def deformation_gradients(x, u, v, vol, horizon, offsets, nbr, broken, Kinv, spr
 
 
 @numba.njit(cache=True)
-def gradients_of(rows, x, u, vol, horizon, offsets, nbr, broken, Kinv, spring, F):
+def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spring, F):
     """F (Eq. 5) of the owned points ``rows`` only (I where spring[i] is odd), into
     F[p] for rows[p]: the same sums, in the same order, as deformation_gradients."""
     N = np.empty((3, 3))
@@ -190,6 +195,7 @@ def gradients_of(rows, x, u, vol, horizon, offsets, nbr, broken, Kinv, spring, F
         if spring[i] % 2 == 1:
             continue
         di = horizon[i]
+        ci = infl[i]
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
@@ -198,7 +204,7 @@ def gradients_of(rows, x, u, vol, horizon, offsets, nbr, broken, Kinv, spring, F
             e1 = x[j, 1] - x[i, 1]
             e2 = x[j, 2] - x[i, 2]
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = influence(di, r) * vol[j]
+            w = influence(ci, di, r) * vol[j]
             y0 = w * (e0 + (u[j, 0] - u[i, 0]))
             y1 = w * (e1 + (u[j, 1] - u[i, 1]))
             y2 = w * (e2 + (u[j, 2] - u[i, 2]))
@@ -272,7 +278,7 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
 
 
 @numba.njit(cache=True)
-def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact, f, fv):
+def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, contact, f, fv):
     """Internal force density f (N/m^3) of every owned point (see module docstring).
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
@@ -290,6 +296,7 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
         b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
         hi = fd[i, 9]
         di = horizon[i]
+        ci = infl[i]
         si = fd[i, 10]
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
@@ -312,7 +319,7 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
                     fz += g * y2 * vj
                 continue
             tx = ty = tz = 0.0
-            wi = influence(di, r)
+            wi = influence(ci, di, r)
             if wi > 0.0:
                 if si == 0.0:
                     tx = wi * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
@@ -321,7 +328,7 @@ def gather_forces(x, u, v, vol, horizon, offsets, nbr, broken, fd, cbb, contact,
                 else:
                     g = _spring(cbb[i], r, y0, y1, y2)
                     tx, ty, tz = g * y0, g * y1, g * y2
-            wj = influence(horizon[j], r)
+            wj = influence(infl[j], horizon[j], r)
             if wj > 0.0:
                 if fd[j, 10] == 0.0:
                     tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)

@@ -1,7 +1,8 @@
 """Updated-Lagrangian (Eulerian) correspondence kernels for the explosive gas
 (paper §2.6, Eqs. 45–48; Silling et al. 2017; Behzadinasab & Foster 2020).
 
-Bonds live in the current configuration: Y = y_j - y_i, omega_i = (delta_i - |Y|)^2.
+Bonds live in the current configuration: Y = y_j - y_i, omega_i = (delta_i - |Y|)^2,
+always quadratic (a part's ``influence`` key acts on the total-Lagrangian kernels only).
 For an owned gas point i over its current family (gas and the solids it acts on):
 
     M_i = sum_j omega_i Y (x) Y V_j                      (Eq. 45)
