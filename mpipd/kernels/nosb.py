@@ -343,9 +343,6 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
                 c = viscous_bond(wi, wj, fd[i, 11], fd[i, 12], fd[j, 11], fd[j, 12],
                                  v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
                                  e0, e1, e2, r)
-                tx -= c * e0
-                ty -= c * e1
-                tz -= c * e2
                 cv = c * vol[j]
                 gx -= cv * e0
                 gy -= cv * e1
@@ -354,9 +351,9 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
             fx += tx * vj
             fy += ty * vj
             fz += tz * vj
-        f[i, 0] = fx
-        f[i, 1] = fy
-        f[i, 2] = fz
+        f[i, 0] = fx + gx
+        f[i, 1] = fy + gy
+        f[i, 2] = fz + gz
         if visc:
             fv[i, 0] = gx
             fv[i, 1] = gy
