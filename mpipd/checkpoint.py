@@ -112,7 +112,9 @@ def write(sim, path, scene_text: str, overrides=()) -> Path:
             with d.collective:
                 d[g0:g1] = arr
         d = f.create_dataset("broken", (total, 2), "i8")
-        with d.collective:
+        # independent I/O: h5py skips the write call for an empty selection, so a
+        # collective write hangs every other rank when one rank has no broken bond
+        if len(pairs):
             d[p0:p0 + len(pairs)] = pairs
     team.barrier()
     if team.root:
