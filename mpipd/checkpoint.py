@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -77,10 +78,30 @@ def _broken_pairs(sim) -> np.ndarray:
     return np.stack([gid[rows[b]], gid[fam.nbr[b]]], axis=1).astype(np.int64)
 
 
-def write(sim, path, scene_text: str, overrides=()) -> Path:
-    import h5py
+def write(sim, path, scene_text: str, overrides=(), run_id: str = "") -> Path:
+    """Write the checkpoint of run ``run_id`` to ``path`` (collective).  If writing
+    fails (a full disk), the partial ``<path>.tmp`` is removed and the error raised;
+    an older checkpoint at ``path`` is untouched."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
+    try:
+        _write(sim, tmp, scene_text, overrides, run_id)
+    except BaseException:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise
+    team = sim.team
+    team.barrier()
+    if team.root:
+        os.replace(tmp, path)
+    team.barrier()
+    return path
+
+
+def _write(sim, tmp, scene_text, overrides, run_id):
+    import h5py
     team = sim.team
     N = sim.n_global
     g0, g1 = sim.gid_range
@@ -91,6 +112,7 @@ def write(sim, path, scene_text: str, overrides=()) -> Path:
     with h5py.File(tmp, "w", driver="mpio", comm=team.comm) as f:
         a = f.attrs
         a["format"] = FORMAT
+        a["run_id"] = run_id
         a["mpipd_version"] = __version__
         a["scene"] = scene_text
         a["overrides"] = json.dumps(list(overrides))
@@ -107,6 +129,8 @@ def write(sim, path, scene_text: str, overrides=()) -> Path:
             a[key] = team.sum(v)
         a["ledger_initial"] = led.initial
         a["bonds_broken"] = sim.bonds_broken()
+        if sim.probes is not None:                # the running peaks, whole run
+            a["probe_peaks"] = json.dumps(sim.probes.peaks())
         for name, arr in _per_point(sim).items():
             d = f.create_dataset(f"points/{name}", (N,) + arr.shape[1:], arr.dtype)
             with d.collective:
@@ -116,24 +140,35 @@ def write(sim, path, scene_text: str, overrides=()) -> Path:
         # collective write hangs every other rank when one rank has no broken bond
         if len(pairs):
             d[p0:p0 + len(pairs)] = pairs
-    team.barrier()
-    if team.root:
-        os.replace(tmp, path)
-    team.barrier()
-    return path
 
 
-def read_scene(path) -> tuple[str, list, int]:
-    """(scene TOML, overrides, step) stored in a checkpoint (serial read, any rank)."""
+@dataclass(frozen=True)
+class Info:
+    """What a checkpoint says about itself (mpipd.rundir matches it to a run file)."""
+    scene: str
+    overrides: list
+    step: int
+    n_points: int
+    run_id: str | None
+
+
+def read_scene(path) -> Info:
+    """The scene TOML, overrides, step, point count and run id stored in a
+    checkpoint (serial read, any rank)."""
     import h5py
+
+    from .rundir import io_reason
+    if not Path(path).is_file():
+        raise CheckpointError(f"{path}: no such checkpoint file")
     try:
         with h5py.File(path, "r") as f:
             if f.attrs.get("format") != FORMAT:
                 raise CheckpointError(f"{path}: not an mpipd checkpoint")
-            return (str(f.attrs["scene"]), json.loads(str(f.attrs["overrides"])),
-                    int(f.attrs["step"]))
+            a = f.attrs
+            return Info(str(a["scene"]), json.loads(str(a["overrides"])), int(a["step"]),
+                        int(a["n_points"]), str(a["run_id"]) if a.get("run_id") else None)
     except (OSError, KeyError, ValueError) as e:
-        raise CheckpointError(f"{path}: cannot read checkpoint ({e})") from None
+        raise CheckpointError(f"{path}: cannot read checkpoint ({io_reason(e)})") from None
 
 
 class SignalFlag:
@@ -162,8 +197,10 @@ class Checkpointer:
       every ``poll`` steps.
     """
 
-    def __init__(self, sim, path, scene_text, overrides=(), every=0, stop_after=None, poll=10):
+    def __init__(self, sim, path, scene_text, overrides=(), every=0, stop_after=None, poll=10,
+                 run_id: str = ""):
         self.sim = sim
+        self.run_id = run_id
         self.path = Path(path)
         self.scene_text = scene_text
         self.overrides = list(overrides)
@@ -190,7 +227,14 @@ class Checkpointer:
     def write_final(self):
         """A last checkpoint for inspection (after a failure), beside the regular one."""
         self.written = write(self.sim, self.path.with_name("checkpoint_failed.h5"),
-                             self.scene_text, self.overrides)
+                             self.scene_text, self.overrides, self.run_id)
+
+    def at_end(self):
+        """The last step's checkpoint, when checkpoints were asked for: a finished
+        run can then be extended (``--restart ... --set time.t_end=...``)."""
+        if self.every:
+            self.written = write(self.sim, self.path, self.scene_text, self.overrides,
+                                 self.run_id)
 
     def after_step(self) -> bool:
         """Checkpoint if due; True if the run should stop now."""
@@ -199,7 +243,8 @@ class Checkpointer:
         if not stop and step % self.poll == 0:
             stop = bool(self.sim.team.max(int(self.signalled)))
         if stop or (self.every and step % self.every == 0):
-            self.written = write(self.sim, self.path, self.scene_text, self.overrides)
+            self.written = write(self.sim, self.path, self.scene_text, self.overrides,
+                                 self.run_id)
         return stop
 
 
@@ -227,6 +272,13 @@ def restore(sim, path) -> None:
                                                  "ledger_jumps", "ledger_contact_jumps",
                                                  "ledger_initial")}
         n_broken = int(f.attrs["bonds_broken"])
+        probe_peaks = json.loads(str(f.attrs["probe_peaks"])) if "probe_peaks" in f.attrs else {}
+    bad = [name for name, arr in data.items()
+           if arr.dtype.kind == "f" and not np.all(np.isfinite(arr))]
+    bad = sorted(set().union(*team.gather(set(bad))))
+    if bad or not all(np.isfinite(v) for v in (t, work, *ledger.values())):
+        raise CheckpointError(f"{path}: non-finite values in " + (", ".join(bad) or "attributes")
+                              + " (a corrupted checkpoint, or one written by a blow-up)")
     c = sim.corr
     sim.u[:n], sim.v[:n], sim.a[:] = data["u"], data["v"], data["a"]
     c.sigma[:], c.R[:], c.V[:], c.W[:] = data["sigma"], data["R"], data["V"], data["W"]
@@ -275,6 +327,8 @@ def restore(sim, path) -> None:
         if len(arr):
             arr[:] = data[key]
     c.Jfac[:] = data["Jfac"]
+    if sim.probes is not None:
+        sim.probes.restore_peaks(probe_peaks)
     sim.initialize()
     sim.a[:] = data["a"]
     c.F_old[:] = data["F_old"]

@@ -22,6 +22,7 @@ from pathlib import Path
 
 EXIT_BAD_INPUT = 2
 EXIT_UNSTABLE = 3
+EXIT_IO = 4          # a run's own file could not be written (disk full, read-only)
 
 
 class UsageError(Exception):
@@ -133,20 +134,28 @@ def _bad_input(team, exc) -> int:
 
 def _run(args, team, signals=None) -> int:
     from . import checkpoint as ck
+    from . import rundir
     from . import scene as sc
     from .decomp import DecompositionError
     from .geometry import check_parts
-    from .output import Writer
+    from .output import n_frames
     from .report import stable_dt
     from .schema import SceneError
-    from .solver import Progress, Simulation, Unstable
+    from .solver import Simulation
 
+    bad_input = (SceneError, DecompositionError, UsageError, ck.CheckpointError,
+                 rundir.RunDirError)
     try:
+        if args.stop_after is not None and args.stop_after < 1:
+            raise UsageError(f"--stop-after must be a step >= 1 (got {args.stop_after})")
         if args.restart:
             if args.scene:
                 raise UsageError("give either SCENE or --restart (the scene is in the checkpoint)")
-            text, overrides, _ = ck.read_scene(args.restart)
-            overrides = overrides + list(args.set)
+            if args.overwrite:
+                raise UsageError("--overwrite replaces a run; a restart continues one")
+            info = ck.read_scene(args.restart)
+            text = info.scene
+            overrides = info.overrides + list(args.set)
             scene = sc.parse(text, str(args.restart), overrides)
             out = Path(args.out) if args.out else Path(args.restart).resolve().parent
         else:
@@ -155,12 +164,17 @@ def _run(args, team, signals=None) -> int:
             source, overrides = sc.expand_case(args.scene, args.set)
             scene, text = sc.load(source, overrides)
             out = Path(args.out) if args.out else Path("runs") / scene.name
-        h5 = out / "run.h5"
-        resume = bool(args.restart) and h5.exists()
-        if h5.exists() and not (args.overwrite or resume):
-            raise UsageError(f"{h5} exists (use --overwrite to replace it, or another --out)")
-        if out.exists() and not out.is_dir():
-            raise UsageError(f"--out {out} exists and is not a directory")
+        h5 = out / rundir.RUN_FILE
+        n_steps = scene.time.n_steps
+        if args.restart:
+            if n_steps < info.step:
+                raise UsageError(f"the run length ({n_steps} steps) ends before the "
+                                 f"checkpoint's step {info.step}")
+            _on_root(team, rundir.check_restart, out, info.run_id, text, info.n_points)
+            _on_root(team, rundir.check_layout, h5, n_frames(n_steps, scene.output.every),
+                     scene.output.every, scene.time.dt)
+        else:
+            _on_root(team, rundir.check_new_run, out, args.overwrite)
         check_parts(scene.parts)             # geometry first: empty, oversized, overlapping
         dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
         if scene.time.dt > dt_stable and not args.force:
@@ -169,11 +183,53 @@ def _run(args, team, signals=None) -> int:
         sim = Simulation(scene, team)
         if args.restart:
             ck.restore(sim, args.restart)
-    except (SceneError, DecompositionError, UsageError, ck.CheckpointError) as e:
+        _on_root(team, rundir.ensure_writable, out)          # the first write of the run
+    except bad_input as e:
         return _bad_input(team, e)
-    n_steps = scene.time.n_steps
+    if args.restart:
+        run_id, resume, shown = info.run_id, True, _shown(text, overrides)
+    else:
+        run_id, resume, shown = team.bcast(rundir.new_run_id() if team.root else None), \
+            False, _shown(text, overrides)
+        if args.overwrite and team.root:
+            rundir.clear_old_run(out)
+    team.barrier()
+    try:
+        return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
+                       n_steps, dt_stable, run_id, resume)
+    except OSError as e:
+        for tmp in out.glob("*.h5.tmp"):         # a checkpoint that did not finish
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+        raise rundir.IOFailure(f"cannot write in {out}: {rundir.io_reason(e)}") from None
+
+
+def _shown(text: str, overrides) -> str:
+    """The scene text as a run file stores it: the TOML and its --set overrides."""
+    from .rundir import OVERRIDES_MARK
+    return text + (OVERRIDES_MARK + "".join(f"# {o}\n" for o in overrides) if overrides else "")
+
+
+def _on_root(team, fn, *args):
+    """Run a serial check on rank 0; its error (or None) is raised on every rank."""
+    err = None
     if team.root:
-        out.mkdir(parents=True, exist_ok=True)
+        try:
+            fn(*args)
+        except Exception as e:               # re-raised on every rank below
+            err = e
+    err = team.bcast(err)
+    if err is not None:
+        raise err
+
+
+def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
+            dt_stable, run_id, resume) -> int:
+    from . import checkpoint as ck
+    from .output import Writer
+    from .solver import Progress, Unstable
     log = RunLog(out / "run.log", team)
     what = f"restart at step {sim.step_count}, " if args.restart else ""
     log(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
@@ -184,19 +240,18 @@ def _run(args, team, signals=None) -> int:
     if sim.n_spring_global:
         log(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
             "(shape tensor not invertible)")
+    for note in (sim.probes.notes if sim.probes is not None else ()):
+        log(f"mpipd: warning: {note}")
     if sim.interface is not None:
         full, planar, left = (team.sum(c) for c in sim.interface.counts)
         log(f"mpipd: interface correction: {full} point(s) in full, {planar} in the x-y "
             f"plane (near a z face); {left} keep their ghost force (an interface within "
             "two horizons of an x-y free surface, README)")
-    team.barrier()
-    shown = text + ("\n# overrides (--set)\n" + "".join(f"# {o}\n" for o in overrides)
-                    if overrides else "")
-    writer = Writer(h5, sim, shown, n_steps, resume=resume)
+    writer = Writer(h5, sim, shown, n_steps, resume=resume, run_id=run_id)
     progress = None if args.quiet else Progress(team, scene.solver.progress_every, log=log)
     checkpointer = ck.Checkpointer(sim, out / "checkpoint.h5", text, overrides,
                                    every=scene.output.checkpoint_every,
-                                   stop_after=args.stop_after)
+                                   stop_after=args.stop_after, run_id=run_id)
     checkpointer.install_signals(signals)
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
@@ -206,6 +261,8 @@ def _run(args, team, signals=None) -> int:
         log(f"mpipd: error: {e}; state saved in {checkpointer.written}", error=True)
         return EXIT_UNSTABLE
     writer.close()
+    if sim.step_count == n_steps:
+        checkpointer.at_end()
     if sim.step_count < n_steps:
         log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; checkpoint "
             f"{checkpointer.written}; continue with `mpipd run --restart {checkpointer.written}`")

@@ -170,6 +170,24 @@ class BoreholePressure:
         else:
             fail(path, "give either p0, alpha, beta (pulse) or times, pressures (table)")
 
+    def check_parts(self, parts, path):
+        """The radius must be a wall: some part has a first layer there
+        (radius <= r < radius + dx) and no points inside it (r < radius)."""
+        walls = 0
+        for part in parts:
+            sx, sy = part.shape.cross_section(part.dx)
+            rr = np.hypot(sx - self.center[0], sy - self.center[1])
+            layer = np.count_nonzero((rr >= self.radius) & (rr < self.radius + part.dx))
+            inside = np.count_nonzero(rr < self.radius)
+            if layer and inside:
+                fail(join(path, "radius"), f"radius {self.radius:g} m lands inside part "
+                     f"{part.name!r} ({inside} of its points a level lie at r < radius): "
+                     "no borehole wall there")
+            walls += layer
+        if not walls:
+            fail(join(path, "radius"), f"radius {self.radius:g} m about ({self.center[0]:g}, "
+                 f"{self.center[1]:g}) m meets no part: no borehole wall to load")
+
     def value(self, t: float) -> float:
         if self.p0 is not None:
             return self.p0 * (np.exp(-self.alpha * t) - np.exp(-self.beta * t))

@@ -79,12 +79,31 @@ def field_values(sim, name: str) -> np.ndarray:
     return FIELD_VALUES[name](sim)
 
 
+#: bytes of one chunk of a frame dataset (a frame is split into chunks of about this size)
+CHUNK_BYTES = 1 << 22
+
+
+def growable(shape) -> dict:
+    """Options of a frame (or probe) dataset that a restart can resize along axis 0:
+    chunked, one frame a chunk row, about CHUNK_BYTES a chunk; unwritten rows are NaN."""
+    rest = shape[2:] if len(shape) > 2 else ()
+    width = int(np.prod(rest)) if rest else 1
+    if len(shape) == 1:
+        chunks = (max(1, min(shape[0], CHUNK_BYTES // 8)),)
+    else:
+        chunks = (1, max(1, min(shape[1], CHUNK_BYTES // (8 * width))), *rest)
+    return {"maxshape": (None, *shape[1:]), "chunks": chunks, "fillvalue": np.nan}
+
+
 class Writer:
     """Collective writer of one run file.  All ranks call every method."""
 
-    def __init__(self, path, sim, scene_text: str, n_steps: int, resume: bool = False):
-        """Create the run file — or, with ``resume``, reopen it and continue after the
-        frames up to the simulation's current step (restart)."""
+    def __init__(self, path, sim, scene_text: str, n_steps: int, resume: bool = False,
+                 run_id: str = ""):
+        """Create the run file for run ``run_id`` — or, with ``resume``, reopen it and
+        continue after the frames up to the simulation's current step (restart).
+        A restart may change the run length: the frame and probe datasets grow or
+        shrink along their first axis (mpipd.rundir.check_layout refuses the rest)."""
         import h5py
         self.path = Path(path)
         self.sim = sim
@@ -96,18 +115,25 @@ class Writer:
         comm = sim.team.comm
         if resume:
             self.f = h5py.File(self.path, "r+", driver="mpio", comm=comm)
+            self.run_id = str(self.f.attrs["run_id"])
+            self.f.attrs["scene"] = scene_text         # with the restart's overrides
             self.dsets = {name: self.f["fields"][name] for name in self.fields}
             self.time = self.f["time"]
             self.energy = {k: self.f["energy"][k] for k in self.f["energy"]}
             self.frame_no = sim.step_count // self.every + 1
-            if self.dsets and next(iter(self.dsets.values())).shape[0] != self.n_frames:
-                raise ValueError(f"{self.path} was sized for another run length")
+            if self.time.shape[0] != self.n_frames:          # a new run length
+                for d in (*self.dsets.values(), self.time, *self.energy.values()):
+                    d.resize(self.n_frames, axis=0)
+                self.f.attrs["steps"] = n_steps
             if sim.probes is not None:
                 sim.probes.create(self.f, n_steps + 1)
             return
         self.f = h5py.File(self.path, "w", driver="mpio", comm=comm)
         N = sim.n_global
         a = self.f.attrs
+        self.run_id = run_id
+        a["run_id"] = run_id
+        a["every"] = self.every
         a["scene"] = scene_text
         a["scene_name"] = scene.name
         a["mpipd_version"] = __version__
@@ -135,14 +161,16 @@ class Writer:
         for name in self.fields:
             k = OUTPUT_FIELDS[name][0]
             shape = (self.n_frames, N) if k == 1 else (self.n_frames, N, k)
-            self.dsets[name] = fg.create_dataset(name, shape, "f8")
-        self.time = self.f.create_dataset("time", (self.n_frames,), "f8")
+            self.dsets[name] = fg.create_dataset(name, shape, "f8", **growable(shape))
+        self.time = self.f.create_dataset("time", (self.n_frames,), "f8",
+                                          **growable((self.n_frames,)))
         eg = self.f.create_group("energy")
         eg.attrs["doc"] = ("energy ledger (J), see mpipd.ledger: held = kinetic + integrator + "
                            "elastic + hourglass + spring + contact + gas; dissipated = plastic "
                            "+ removed + viscous + damping + gas_damping + interface; balance = "
                            "(initial + external - held - dissipated) / scale")
-        self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8") for k in TERMS}
+        self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8",
+                                            **growable((self.n_frames,))) for k in TERMS}
         if sim.probes is not None:
             sim.probes.create(self.f, n_steps + 1)
 

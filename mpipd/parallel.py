@@ -53,15 +53,29 @@ class Team:
         self.comm.Abort(code)
 
 
+class Fatal(RuntimeError):
+    """An error with a known cause (disk full, ...): :func:`abort_on_error` prints
+    it as one line ``mpipd: error: <what>`` instead of a traceback, and exits with
+    ``exit_code``."""
+    exit_code = 1
+
+
 def abort_on_error(team: Team, fn, *args):
-    """Run ``fn(*args)``; if it raises on any rank, print the traceback and abort
-    the whole MPI job (a plain exit would leave the other ranks waiting forever)."""
+    """Run ``fn(*args)``; if it raises on any rank, print the traceback (one line
+    for a :class:`Fatal`) and abort the whole MPI job (a plain exit would leave the
+    other ranks waiting forever)."""
     import sys
     import traceback
     try:
         return fn(*args)
     except SystemExit:
         raise
+    except Fatal as e:
+        sys.stderr.write(f"mpipd: error: {e}\n")
+        sys.stderr.flush()
+        if team.size > 1:
+            team.abort(e.exit_code)
+        return e.exit_code
     except BaseException:
         sys.stderr.write(f"mpipd: rank {team.rank} failed:\n{traceback.format_exc()}")
         sys.stderr.flush()

@@ -1,7 +1,9 @@
 """Probes: named points whose state is recorded every step (paper Figs. 15–16).
 
 Each probe is the lattice point nearest its ``position`` (lowest gid on a tie),
-among the points of its ``part`` if it names one (a part name matches the part
+among the points of its ``part`` if it names one (a probe farther than that
+point's horizon from it is refused as outside the body; one moved by more
+than dx is reported in the run log) (a part name matches the part
 and its zones ``<part>.band``, ``<part>.0``, ... of :meth:`mpipd.scene.Part.zones`,
 so ``part = "rock"`` samples the rock whatever its resolution bands); the rank
 that owns it records, every step,
@@ -26,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .materials.jh2 import jh2_strength
+from .schema import fail
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
 
@@ -57,6 +60,7 @@ class Probes:
         parts = [q.name for q in sim.scene.parts]
         self.part_names, self.material_names = parts, list(sim.scene.materials)
         self.mine = []                      # (probe index, local index)
+        self.notes = []                     # warnings for the run log
         self.gid, self.x, self.dist, self.part, self.material = [], [], [], [], []
         for k, pr in enumerate(self.probes):
             d = np.linalg.norm(x - np.asarray(pr.position), axis=1) if n else np.empty(0)
@@ -65,11 +69,21 @@ class Probes:
                 d = np.where(ok[part], d, np.inf)
             j = int(np.argmin(d)) if n else -1
             best = ((float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
-                     int(mat[j])) if n and np.isfinite(d[j]) else (math.inf, -1))
+                     int(mat[j]), float(sim.points.dx[j]), float(sim.points.horizon[j]))
+                    if n and np.isfinite(d[j]) else (math.inf, -1))
             found = min(sim.team.gather(best))
+            key = f"probes[{k}].position"
             if not math.isfinite(found[0]):
-                raise ValueError(f"probe {pr.name!r}: no point of part {pr.part!r}")
-            dist, g, xg, pg, mg = found
+                fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
+            dist, g, xg, pg, mg, dxg, hg = found
+            if dist > hg:
+                fail(key, f"probe {pr.name!r}: the nearest point"
+                     f"{' of part ' + repr(pr.part) if pr.part else ''} is {dist * 1e3:.3g} mm "
+                     f"away, beyond its horizon ({hg * 1e3:.3g} mm): outside the body?")
+            if dist > dxg:                 # more than a lattice spacing: say so
+                self.notes.append(f"probe {pr.name!r} moved {dist * 1e3:.3g} mm (more than dx = "
+                                  f"{dxg * 1e3:.3g} mm) to the nearest point, at "
+                                  f"({xg[0]:.4g}, {xg[1]:.4g}, {xg[2]:.4g}) m")
             self.gid.append(g)
             self.x.append(xg)
             self.dist.append(dist)
@@ -79,7 +93,9 @@ class Probes:
             if len(local):
                 self.mine.append((k, int(local[0])))
         self.rows = {k: [] for k, _ in self.mine}
-        self.history = {k: [] for k, _ in self.mine}   # (t, sigma_rr, v_r, p) for the peaks
+        # running peaks over every step of the run (checkpointed, so a restart
+        # continues them): most compressive sigma_rr, largest |v_r|, largest p
+        self.peak = {k: [math.inf, 0.0, -math.inf] for k, _ in self.mine}
         self.start = {k: 0 for k, _ in self.mine}       # step of the first buffered row
         self._jh2 = {}
         for g in sim.corr.groups:
@@ -90,9 +106,8 @@ class Probes:
     def peaks(self) -> dict:
         """name -> (most compressive sigma_rr, largest |v_r|, largest p) so far, gathered
         from the owner ranks (every rank gets the same dict)."""
-        local = {self.probes[k].name: (min(r[1] for r in rows), max(abs(r[2]) for r in rows),
-                                       max(r[3] for r in rows))
-                 for k, rows in self.history.items() if rows}
+        local = {self.probes[k].name: tuple(pk) for k, pk in self.peak.items()
+                 if math.isfinite(pk[0])}
         out = {}
         for part in self.sim.team.gather(local):
             out.update(part)
@@ -115,7 +130,14 @@ class Probes:
                 self.start[k] = sim.step_count
             row = (sim.t, srr, vr, p, seq, self._strength(i))
             self.rows[k].append(row)
-            self.history[k].append(row[:4])
+            pk = self.peak[k]
+            pk[0], pk[1], pk[2] = min(pk[0], srr), max(pk[1], abs(vr)), max(pk[2], p)
+
+    def restore_peaks(self, peaks: dict):
+        """Continue the running peaks of a checkpoint (name -> peaks(), as written)."""
+        for k in self.peak:
+            if self.probes[k].name in peaks:
+                self.peak[k] = list(peaks[self.probes[k].name])
 
     def _strength(self, i) -> float:
         if i not in self._jh2 or self.sim.mode[i] != 0:
@@ -130,6 +152,7 @@ class Probes:
 
     def create(self, h5, n_rows: int):
         """Collective: datasets for every probe (all ranks call this)."""
+        from .output import growable
         self.dsets = {}
         for k, pr in enumerate(self.probes):
             grp = h5.require_group(f"probes/{pr.name}")
@@ -140,8 +163,15 @@ class Probes:
             grp.attrs["part"] = self.part[k]
             grp.attrs["material"] = self.material[k]
             grp.attrs["requested_part"] = pr.part or ""
-            self.dsets[k] = {q: grp.require_dataset(q, (n_rows,), "f8", fillvalue=np.nan)
-                             for q in QUANTITIES}
+            self.dsets[k] = {}
+            for q in QUANTITIES:
+                if q in grp:                        # a restart: the run length may change
+                    d = grp[q]
+                    if d.shape[0] != n_rows:
+                        d.resize(n_rows, axis=0)
+                else:
+                    d = grp.create_dataset(q, (n_rows,), "f8", **growable((n_rows,)))
+                self.dsets[k][q] = d
 
     def flush(self):
         """Owner ranks write their buffered rows at row = step (independent I/O)."""

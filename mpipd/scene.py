@@ -292,6 +292,9 @@ class Scene:
             for a in self.materials[m].interacts_with:
                 if a not in self.materials or a == m:
                     fail(f"materials.{m}.interacts_with", f"no other material {a!r}")
+        for i, ld in enumerate(self.loads):
+            if hasattr(ld, "check_parts"):          # loads placed on the geometry
+                ld.check_parts(self.parts, f"loads[{i}]")
         seen = set()
         for i, pr in enumerate(self.probes):
             if pr.name in seen or not pr.name.isidentifier():
@@ -410,8 +413,16 @@ def parse(text: str, origin: str = "scene", overrides=()) -> Scene:
     except tomllib.TOMLDecodeError as e:
         fail(origin, f"not a valid TOML file: {e}")
     for o in overrides:
-        apply_override(raw, *parse_override(o))
+        path, value = parse_override(o)
+        apply_override(raw, path, value)
+        for other in EXCLUSIVE.get(tuple(path), ()):     # the later setting wins
+            raw.get(other[0], {}).pop(other[1], None)
     return build(Scene, raw)
+
+
+#: keys of which a scene gives one: an override of one removes the others
+EXCLUSIVE = {("time", "steps"): (("time", "t_end"),),
+             ("time", "t_end"): (("time", "steps"),)}
 
 
 @dataclass(frozen=True)
