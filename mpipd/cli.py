@@ -197,13 +197,16 @@ def _run(args, team, signals=None) -> int:
     try:
         return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
                        n_steps, dt_stable, run_id, resume)
-    except OSError as e:
+    except Exception as e:
+        cause = rundir.io_cause(e)
+        if cause is None:
+            raise
         for tmp in out.glob("*.h5.tmp"):         # a checkpoint that did not finish
             try:
                 tmp.unlink()
             except OSError:
                 pass
-        raise rundir.IOFailure(f"cannot write in {out}: {rundir.io_reason(e)}") from None
+        raise rundir.IOFailure(rundir.describe_io(cause, out)) from None
 
 
 def _shown(text: str, overrides) -> str:

@@ -71,11 +71,15 @@ def abort_on_error(team: Team, fn, *args):
     except SystemExit:
         raise
     except Fatal as e:
+        import os
         sys.stderr.write(f"mpipd: error: {e}\n")
         sys.stderr.flush()
+        sys.stdout.flush()
         if team.size > 1:
             team.abort(e.exit_code)
-        return e.exit_code
+        # files may be left open by the failure: leave now, before the interpreter's
+        # teardown closes them after MPI_Finalize (HDF5 crashes there)
+        os._exit(e.exit_code)
     except BaseException:
         sys.stderr.write(f"mpipd: rank {team.rank} failed:\n{traceback.format_exc()}")
         sys.stderr.flush()

@@ -160,6 +160,31 @@ def io_reason(exc: BaseException) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def io_cause(exc: BaseException) -> OSError | None:
+    """The OSError behind ``exc``, itself or in its chain (h5py raises a
+    RuntimeError when closing a file whose write failed); None if none."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, OSError):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def describe_io(exc: OSError, out: Path) -> str:
+    """One line: the reason, and the free space left where the run writes
+    (HDF5's MPI-IO driver often reports only 'file write failed')."""
+    reason = io_reason(exc)
+    try:
+        st = os.statvfs(out)
+        free = st.f_bavail * st.f_frsize
+        reason += f" ({free / 1e6:.3g} MB free on that file system)"
+    except OSError:
+        pass
+    return f"cannot write in {out}: {reason}"
+
+
 class IOFailure(Fatal):
     """Writing a run's own file failed (disk full, read-only, quota): one line, exit 4."""
     exit_code = 4

@@ -26,7 +26,13 @@ def reference(tmp_path_factory):
     res = run_cli(["run", "granite_ring", "--out", str(out), *ARGS], ranks=1)
     assert res.returncode == 0, res.stderr
     with h5py.File(out / "run.h5", "r") as f:
-        return {k: f[k][...] for k in KEYS} | {"broken": f.attrs["bonds_broken"]}
+        return {k: f[k][...] for k in KEYS} | {"broken": f.attrs["bonds_broken"],
+                                               "probe_lines": probe_lines(res.stdout)}
+
+
+def probe_lines(stdout):
+    """The run log's probe peaks ('mpipd: probe near: peak radial stress ...')."""
+    return [ln for ln in stdout.splitlines() if ln.startswith("mpipd: probe ")]
 
 
 def test_restart_same_and_different_rank_count(tmp_path, reference):
@@ -38,6 +44,10 @@ def test_restart_same_and_different_rank_count(tmp_path, reference):
     for d, n in ((a, 2), (tmp_path / "b", 3)):
         res = run_cli(["run", "--restart", str(d / "checkpoint.h5"), "--quiet"], ranks=n)
         assert res.returncode == 0, res.stdout + res.stderr
+        # the peaks cover the whole run, not the steps since the restart (the near
+        # probe's peak falls before step 230)
+        assert probe_lines(res.stdout) == reference["probe_lines"]
+        assert len(reference["probe_lines"]) == 2
         with h5py.File(d / "run.h5", "r") as f:
             assert f.attrs["bonds_broken"] == reference["broken"]
             for k in KEYS:
