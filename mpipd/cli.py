@@ -10,8 +10,12 @@
 SCENE is a TOML file or the name of a built-in scene.  Bad input (scene
 errors, an existing output file, a decomposition that cannot work) prints one
 line ``mpipd: error: <what>`` on rank 0 and exits with status 2 on every rank,
-before anything is written.  Any other exception on any rank prints its
-traceback and aborts the whole MPI job, so nothing hangs.
+before anything is written.  A run writes only its own files (mpipd.rundir:
+run ids, the restart and --overwrite rules).  A file of the run that cannot be
+written (disk full, read-only) prints one line and exits with status 4; a
+blow-up exits with 3; a clean stop with a checkpoint (--stop-after, SIGTERM or
+SIGUSR1) with 0.  Any other exception on any rank prints its traceback and
+aborts the whole MPI job, so nothing hangs.
 """
 from __future__ import annotations
 
