@@ -12,6 +12,12 @@ rank within reach, not just the neighbours, and the halo exchanges directly
 with each of them (see :mod:`mpipd.halo`).  Only a rank with no z level at all
 is refused.
 
+Replicated parts.  The explosive gas moves far from its reference slab, and
+the solids it acts on (its ``interacts_with`` materials) are in its family
+wherever it goes, so both are held whole on every rank (:func:`replicated_parts`):
+a gas point owned by rank r may come within a horizon of a solid point whose
+layer is beyond r's halo, and r must see that point as the 1-rank run does.
+
 Local layout on a rank: owned points first (gid order), then ghosts (gid
 order).  Because owners hold contiguous gid ranges, the ghosts coming from one
 rank — and the owned points going to one rank — are contiguous local slices.
@@ -35,7 +41,7 @@ class Slabs:
     table: LayerTable
     bounds: np.ndarray          # rank r owns layers [bounds[r], bounds[r+1])
     halo: float
-    gas_parts: frozenset = frozenset()   # parts replicated on every rank (explosive gas)
+    replicated: frozenset = frozenset()  # parts held whole on every rank (gas, and what it acts on)
 
     @property
     def n_ranks(self) -> int:
@@ -59,22 +65,22 @@ class Slabs:
                 int(np.searchsorted(z, z1 + self.halo, side="right")))
 
     def ghost_layers(self, r: int) -> np.ndarray:
-        """Static ghosts (within the halo), then every other gas layer (by owner, gid)."""
-        return np.concatenate((self.static_ghost_layers(r), self.gas_layers_beyond(r)))
+        """Static ghosts (within the halo), then every other replicated layer (by owner, gid)."""
+        return np.concatenate((self.static_ghost_layers(r), self.replicated_layers_beyond(r)))
 
     def static_ghost_layers(self, r: int) -> np.ndarray:
         lo, hi = self.reach(r)
         a, b = self.owned(r)
         return np.concatenate((np.arange(lo, a), np.arange(b, hi)))
 
-    def gas_layers_beyond(self, r: int) -> np.ndarray:
-        """Gas layers outside rank r's reach: gas moves far, so every rank holds all of it."""
-        if not self.gas_parts:
+    def replicated_layers_beyond(self, r: int) -> np.ndarray:
+        """Layers of the replicated parts outside rank r's reach (every rank holds them)."""
+        if not self.replicated:
             return np.empty(0, np.int64)
         lo, hi = self.reach(r)
         L = np.arange(len(self.table.z))
-        gas = np.isin(self.table.part, list(self.gas_parts))
-        return L[gas & ((L < lo) | (L >= hi))]
+        rep = np.isin(self.table.part, list(self.replicated))
+        return L[rep & ((L < lo) | (L >= hi))]
 
     def points_of(self, r: int) -> tuple[int, int]:
         """(owned, ghost) point counts of rank r."""
@@ -106,7 +112,7 @@ class Slabs:
                 sel = base[own == q]
                 start = int(gstart[sel[0]])
                 recv.append((int(q), start, start + int(counts[ghosts[sel]].sum())))
-        # receives come as one contiguous range per (peer, kind): static first, then gas
+        # receives come as one contiguous range per (peer, kind): static first, then replicated
         recv.sort(key=lambda e: (e[0], e[1]))
         ostart = np.concatenate(([0], np.cumsum(counts[a:b]))).astype(np.int64)
         send = []
@@ -117,7 +123,7 @@ class Slabs:
             slo, shi = max(lo, a), min(hi, b)
             if shi > slo:
                 send.append((q, int(ostart[slo - a]), int(ostart[shi - a])))
-            beyond = self.gas_layers_beyond(q)
+            beyond = self.replicated_layers_beyond(q)
             mine = beyond[(beyond >= a) & (beyond < b)]
             if len(mine):
                 idx = np.concatenate([np.arange(ostart[L - a], ostart[L - a + 1]) for L in mine])
@@ -125,8 +131,9 @@ class Slabs:
         return recv, send
 
 
-def decompose(table: LayerTable, n_ranks: int, halo: float, gas_parts=()) -> Slabs:
-    """Split the layers into ``n_ranks`` slabs of whole z levels, balanced by points."""
+def decompose(table: LayerTable, n_ranks: int, halo: float, replicated=()) -> Slabs:
+    """Split the layers into ``n_ranks`` slabs of whole z levels, balanced by points;
+    the parts ``replicated`` (indices) are ghosts wherever they are not owned."""
     z = table.z
     # candidate cut positions: layer indices where z changes
     cuts = np.nonzero(np.diff(z) > 0)[0] + 1
@@ -148,7 +155,7 @@ def decompose(table: LayerTable, n_ranks: int, halo: float, gas_parts=()) -> Sla
         bounds.append(int(cand[k]))
     bounds.append(len(z))
     return Slabs(table=table, bounds=np.asarray(bounds, dtype=np.int64), halo=float(halo),
-                 gas_parts=frozenset(gas_parts))
+                 replicated=frozenset(replicated))
 
 
 @dataclass
@@ -185,6 +192,17 @@ def local_points(scene, slabs: Slabs, r: int) -> Points:
         influence=np.array([INFLUENCE[p.influence] for p in scene.parts], dtype=np.uint8)[part],
         n_owned=int(slabs.table.count[a:b].sum()),
     )
+
+
+def replicated_parts(scene) -> list[int]:
+    """Indices of the parts every rank holds whole: the explosive gas (``is_gas``
+    materials) and the parts of every material an explosive ``interacts_with``.
+    A gas point's current family is every such point within its horizon of its
+    current position, which may be any distance from its owner's slab."""
+    mats = scene.materials
+    gas = {m for m, mat in mats.items() if getattr(mat, "is_gas", False)}
+    acts = {a for m in gas for a in mats[m].interacts_with}
+    return [k for k, q in enumerate(scene.parts) if q.material in gas | acts]
 
 
 def halo_width(scene) -> float:

@@ -3,7 +3,10 @@ detonation (paper §2.6, Eqs. 45–48).  Built only when a scene has a ``jwl``
 material.
 
 * Every rank holds every gas point (owned, or as a ghost: the halo replicates the
-  gas, which moves far from its reference slab, and is a few per cent of a model).
+  gas, which moves far from its reference slab, and is a few per cent of a model),
+  and every point of the ``interacts_with`` solids: a gas point may come within its
+  horizon of any of them, however far it is from its owner's slab
+  (:func:`mpipd.decomp.replicated_parts`).
 * Families live in the current configuration: for each owned gas point, the gas
   and the ``interacts_with`` solids within the gas horizon; for each owned such
   solid, the gas points whose horizon reaches it.  No total-Lagrangian bond

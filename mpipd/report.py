@@ -36,7 +36,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .decomp import decompose, halo_width
+from .decomp import decompose, halo_width, replicated_parts
 from .geometry import LayerTable
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
@@ -170,8 +170,7 @@ def wave_speed_limit(mat, c_max: float):
 def check_report(scene, ranks: int) -> str:
     table = LayerTable.from_parts(scene.parts, scene.material_ids)
     halo = halo_width(scene)
-    gas_parts = [k for k, q in enumerate(scene.parts) if is_gas_part(scene, q)]
-    slabs = decompose(table, ranks, halo, gas_parts)
+    slabs = decompose(table, ranks, halo, replicated_parts(scene))
     bonds = layer_bonds(scene, table)
     dt = scene.time.dt
     out = [f"scene {scene.name!r}: {scene.scene.description}".rstrip(": ")]
@@ -193,7 +192,9 @@ def check_report(scene, ranks: int) -> str:
                    f"({p.horizon_factor:g} dx), influence {p.influence}, {npts} points, "
                    + ("updated-Lagrangian gas: families re-found every step, held on every rank"
                       if is_gas_part(scene, p) else
-                      f"{nb} bonds ({nb / max(npts, 1):.1f} per point, {fam} in the bulk)"))
+                      f"{nb} bonds ({nb / max(npts, 1):.1f} per point, {fam} in the bulk)"
+                      + ("; the gas acts on it: held on every rank" if k in slabs.replicated
+                         else "")))
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
     out.append("  per material (bonds counted from the lattice cross-sections, the model is "

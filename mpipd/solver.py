@@ -3,7 +3,8 @@
 :class:`Simulation` is built on every rank from the same validated scene and
 the run's :class:`mpipd.parallel.Team`:
 
-1. layer table -> slab decomposition -> this rank's owned + ghost points only;
+1. layer table -> slab decomposition -> this rank's owned + ghost points only
+   (the explosive gas and its ``interacts_with`` solids: all of them, as ghosts);
 2. halo plan, families (CSR, gid-sorted), material groups, correspondence state;
 3. initial and boundary conditions, initial forces.
 
@@ -26,7 +27,7 @@ import time as _time
 import numpy as np
 
 from .correspondence import Correspondence
-from .decomp import decompose, halo_width, local_points
+from .decomp import decompose, halo_width, local_points, replicated_parts
 from .failure import Failure
 from .families import build_families
 from .geometry import LayerTable
@@ -51,7 +52,8 @@ class Simulation:
         table = LayerTable.from_parts(scene.parts, scene.material_ids)
         gas_parts = [k for k, q in enumerate(scene.parts)
                      if getattr(scene.materials[q.material], "is_gas", False)]
-        self.slabs = decompose(table, team.size, halo_width(scene), gas_parts)
+        # the gas and the solids it acts on are held whole on every rank
+        self.slabs = decompose(table, team.size, halo_width(scene), replicated_parts(scene))
         self.n_global = table.n_points
         self.gid_range = self.slabs.gid_range(team.rank)
         p = self.points = local_points(scene, self.slabs, team.rank)

@@ -89,3 +89,23 @@ def test_too_many_ranks_refused():
     table = LayerTable.from_parts(scene.parts, scene.material_ids)
     with pytest.raises(DecompositionError, match="3 z levels"):
         decompose(table, 4, halo_width(scene))
+
+
+def test_gas_and_the_solids_it_acts_on_are_on_every_rank():
+    """detonation_tube: the charge and the copper it acts on (interacts_with) are held
+    whole on every rank; the rock, which the gas does not touch, only within the halo."""
+    from mpipd import scene as sc
+    from mpipd.decomp import replicated_parts
+    scene, _ = sc.load("detonation_tube")
+    names = [q.name for q in scene.parts]
+    assert [names[k] for k in replicated_parts(scene)] == ["charge", "tube"]
+    table = LayerTable.from_parts(scene.parts, scene.material_ids)
+    slabs = decompose(table, 3, halo_width(scene), replicated_parts(scene))
+    for r in range(3):
+        p = local_points(scene, slabs, r)
+        for k in (0, 1):
+            assert np.sum(p.part == k) == table.count[table.part == k].sum()
+        rock = p.part == 2
+        z0, z1 = slabs.z_range(r)
+        assert rock.sum() < table.count[table.part == 2].sum()
+        assert np.all((p.x[rock, 2] > z0 - slabs.halo) & (p.x[rock, 2] < z1 + slabs.halo))
