@@ -1,5 +1,6 @@
 # mpipd — set-up, demo, tests, benchmarks.  `make demo` and `make test` each do the
-# whole set-up first (Debian packages, .venv, mpi4py + parallel h5py), idempotently.
+# whole set-up first (Debian packages, .venv, mpi4py + parallel h5py), idempotently;
+# `make test` also installs Debian's ParaView (pvbatch, for tests/test_paraview.py).
 SHELL := /bin/bash
 VENV ?= .venv
 PY := $(VENV)/bin/python
@@ -12,7 +13,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install demo test bench clean
+.PHONY: install paraview demo test bench clean
 
 install: $(STAMP)
 
@@ -20,13 +21,17 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 	bash scripts/bootstrap.sh
 	touch $@
 
+# Debian's paraview + python3-paraview, no recommends; a no-op once pvbatch is there
+paraview:
+	bash scripts/install_paraview.sh
+
 demo: install
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/demo --overwrite
 	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
 	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/demo/run.h5 --out runs/demo/report
 	@echo "demo: the fracture pattern is in $(CURDIR)/runs/demo/fracture.png (validation report: runs/demo/report/report.md, fields: runs/demo/run.h5, ParaView: runs/demo/run.xdmf)"
 
-test: install
+test: install paraview
 	$(PY) -m pytest -q -ra tests
 
 bench: install

@@ -17,7 +17,14 @@ does not depend on the number of ranks that wrote it::
     /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
-``run.xdmf`` beside the file opens the fields in ParaView.
+
+``run.xdmf`` beside the file (written by rank 0 when the writer closes, so at the
+end of a run, of a ``--stop-after`` and of a restart, for the frames written so
+far) opens every field at every frame in ParaView: one Uniform grid a frame in a
+temporal collection, the points as a Polyvertex on ``/geometry/x`` (gid order),
+each field a selection of frame k of ``/fields/<name>``, spelled so that all three
+of ParaView 5.11's XDMF readers load it (``XDMFReader``, ``Xdmf3ReaderS``,
+``Xdmf3ReaderT``; see ``_xdmf_field_item``).
 """
 from __future__ import annotations
 
@@ -208,7 +215,7 @@ class Writer:
         self.f.close()
         if self.sim.team.root:
             write_xdmf(self.path, self.sim.n_global, self.fields, self.frame_no,
-                       self.time_values())
+                       self.time_values(), self.n_frames)
 
     def time_values(self):
         import h5py
@@ -216,10 +223,57 @@ class Writer:
             return f["time"][: self.frame_no]
 
 
-def write_xdmf(h5path: Path, N: int, fields, frames: int, times) -> Path:
-    """An XDMF 3 file next to ``h5path`` describing every frame as a point cloud."""
+def _xdmf_field_item(h5: str, name: str, k: int, shape) -> list:
+    """The DataItem of frame ``k`` of ``/fields/<name>`` (dataset shape ``shape``).
+
+    ParaView 5.11's XDMF readers sit on two libraries, and each library reads a
+    frame's slice in only one spelling (measured with pvbatch; ``tests/test_paraview.py``
+    checks all three readers):
+
+    * ``XDMFReader`` (libxdmf2) understands a HyperSlab DataItem (children: the
+      start/stride/count selection and the whole dataset).  It also accepts the
+      Xdmf 1 spelling ``Type="HyperSlab"`` for ``ItemType``.
+    * ``Xdmf3ReaderS``/``Xdmf3ReaderT`` (libxdmf3; ``OpenDataFile`` picks
+      ``Xdmf3ReaderS`` for ``.xdmf``) load no HyperSlab item, at any frame: VTK asks
+      the array's number type before reading it, and a HyperSlab, a reference to
+      another item, has none yet, so each field is dropped with "Skipping
+      unrecognized array type [None]".  They do read Xdmf 3's own selection syntax
+      in an HDF item's text, ``file:/dataset|start:stride:count:dataspace``.
+
+    So the item carries both: ``Type="HyperSlab"`` (libxdmf2 takes it as a HyperSlab
+    and reads the two children; Xdmf 3 reads only ``ItemType`` and so takes a plain
+    HDF item), and as its text, before the children, the Xdmf 3 selection (which is
+    what Xdmf 3 takes as the item's content; libxdmf2 ignores a HyperSlab's text).
+    """
+    rank = len(shape)
+    start = (k,) + (0,) * (rank - 1)
+    stride = (1,) * rank
+    count = (1,) + tuple(shape[1:])
+    dims = " ".join(map(str, shape[1:]))            # one frame: N or N k
+
+    def j(v):
+        return " ".join(map(str, v))
+    return [f'<DataItem Type="HyperSlab" Dimensions="{dims}" NumberType="Float" Precision="8" '
+            f'Format="HDF">{h5}:/fields/{name}|{j(start)}:{j(stride)}:{j(count)}:{j(shape)}',
+            f'<DataItem Dimensions="3 {rank}" NumberType="Int" Format="XML">'
+            f'{j(start)} {j(stride)} {j(count)}</DataItem>',
+            f'<DataItem Dimensions="{j(shape)}" NumberType="Float" Precision="8" '
+            f'Format="HDF">{h5}:/fields/{name}</DataItem>',
+            "</DataItem>"]
+
+
+def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | None = None
+               ) -> Path:
+    """An XDMF file next to ``h5path`` describing frames ``0 .. frames-1`` as point clouds.
+
+    ``n_alloc`` is the length of the fields' frame axis in the file (the frames the
+    run was sized for, default ``frames``): a run stopped early has written fewer.
+    Each frame's fields are selections of ``/fields/<name>``, readable by all three
+    of ParaView's XDMF readers (see ``_xdmf_field_item``); the HDF5 layout is the
+    one the rest of mpipd reads."""
     h5 = h5path.name
     out = h5path.with_suffix(".xdmf")
+    n_alloc = frames if n_alloc is None else n_alloc
     lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "<Domain>",
              '<Grid Name="run" GridType="Collection" CollectionType="Temporal">']
     for k in range(frames):
@@ -232,22 +286,12 @@ def write_xdmf(h5path: Path, N: int, fields, frames: int, times) -> Path:
                   f'Format="HDF">{h5}:/geometry/x</DataItem>', "</Geometry>"]
         for name in fields:
             kk = OUTPUT_FIELDS[name][0]
-            kind = {1: "Scalar", 3: "Vector", 6: "Matrix"}[kk]   # stress: Voigt xx yy zz yz xz xy
-            dims = f"{N}" if kk == 1 else f"{N} {kk}"
-            full = f"{frames} {N}" if kk == 1 else f"{frames} {N} {kk}"
-            # hyperslab: start / stride / count of the frame's slice
-            if kk == 1:
-                sel = f"{k} 0 1 1 1 {N}"
-                sd = "3 2"
-            else:
-                sel = f"{k} 0 0 1 1 1 1 {N} {kk}"
-                sd = "3 3"
+            # stress: the file's 6 columns, xx yy zz yz xz xy (ParaView names the
+            # components of a 6-column array XX YY ZZ XY YZ XZ: README)
+            kind = {1: "Scalar", 3: "Vector", 6: "Matrix"}[kk]
+            shape = (n_alloc, N) if kk == 1 else (n_alloc, N, kk)
             lines += [f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">',
-                      f'<DataItem ItemType="HyperSlab" Dimensions="{dims}" Type="HyperSlab">',
-                      f'<DataItem Dimensions="{sd}" Format="XML">{sel}</DataItem>',
-                      f'<DataItem Dimensions="{full}" NumberType="Float" Precision="8" '
-                      f'Format="HDF">{h5}:/fields/{name}</DataItem>',
-                      "</DataItem>", "</Attribute>"]
+                      *_xdmf_field_item(h5, name, k, shape), "</Attribute>"]
         lines.append("</Grid>")
     lines += ["</Grid>", "</Domain>", "</Xdmf>"]
     out.write_text("\n".join(lines) + "\n")
