@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .kernels.linalg import VOIGT
 from .ledger import TERMS
 from .peaks import NAMES as PEAKS
 from .scene import OUTPUT_FIELDS
@@ -223,7 +224,7 @@ class Writer:
             return f["time"][: self.frame_no]
 
 
-def _xdmf_field_item(h5: str, name: str, k: int, shape) -> list:
+def _xdmf_field_item(h5: str, name: str, k: int, shape, column: int | None = None) -> list:
     """The DataItem of frame ``k`` of ``/fields/<name>`` (dataset shape ``shape``).
 
     ParaView 5.11's XDMF readers sit on two libraries, and each library reads a
@@ -250,6 +251,8 @@ def _xdmf_field_item(h5: str, name: str, k: int, shape) -> list:
     stride = (1,) * rank
     count = (1,) + tuple(shape[1:])
     dims = " ".join(map(str, shape[1:]))            # one frame: N or N k
+    if column is not None:                          # one column of an (F, N, k) field
+        start, count, dims = (k, 0, column), (1, shape[1], 1), str(shape[1])
 
     def j(v):
         return " ".join(map(str, v))
@@ -287,11 +290,17 @@ def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | 
         for name in fields:
             kk = OUTPUT_FIELDS[name][0]
             # stress: the file's 6 columns, xx yy zz yz xz xy (ParaView names the
-            # components of a 6-column array XX YY ZZ XY YZ XZ: README)
+            # components of a 6-column array XX YY ZZ XY YZ XZ), so each component
+            # is also a scalar named stress_xx ... stress_xy
             kind = {1: "Scalar", 3: "Vector", 6: "Matrix"}[kk]
             shape = (n_alloc, N) if kk == 1 else (n_alloc, N, kk)
             lines += [f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">',
                       *_xdmf_field_item(h5, name, k, shape), "</Attribute>"]
+            if kk == 6:           # and each component by its name, ParaView's labels aside
+                for c, comp in enumerate(VOIGT):
+                    lines += [f'<Attribute Name="{name}_{comp}" AttributeType="Scalar" '
+                              'Center="Node">', *_xdmf_field_item(h5, name, k, shape, c),
+                              "</Attribute>"]
         lines.append("</Grid>")
     lines += ["</Grid>", "</Domain>", "</Xdmf>"]
     out.write_text("\n".join(lines) + "\n")

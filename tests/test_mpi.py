@@ -72,7 +72,8 @@ def test_output_layout_and_xdmf(runs):
     grids = root.findall("./Domain/Grid/Grid")
     assert len(grids) == 4
     names = {a.get("Name") for a in grids[-1].findall("Attribute")}
-    assert names == {"u", "v", "stress"}
+    assert names == {"u", "v", "stress", *(f"stress_{c}" for c in ("xx", "yy", "zz", "yz", "xz",
+                                                                   "xy"))}
     # frame 3 of u: a HyperSlab for libxdmf2 (children) that Xdmf 3 reads from its text
     # (tests/test_paraview.py opens it with ParaView's readers)
     item = next(a for a in grids[3].findall("Attribute") if a.get("Name") == "u").find("DataItem")

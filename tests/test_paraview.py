@@ -68,3 +68,6 @@ def test_paraview_reads_every_field_at_the_last_frame(ring, tmp_path):
             a = got[f"{r}.{k}"]
             assert a.size == want[k].size, (r, k, a.shape)
             np.testing.assert_array_equal(a.reshape(want[k].shape), want[k], err_msg=f"{r} {k}")
+        for c, comp in enumerate(("xx", "yy", "zz", "yz", "xz", "xy")):   # named components
+            np.testing.assert_array_equal(got[f"{r}.stress_{comp}"], want["stress"][:, c],
+                                          err_msg=f"{r} stress_{comp}")

@@ -50,6 +50,10 @@ def mul3_at(a, b, out):
             out[r, c] = a[0, r] * b[0, c] + a[1, r] * b[1, c] + a[2, r] * b[2, c]
 
 
+#: the Voigt order of every 6-column symmetric tensor (stress, d) in mpipd
+VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
+
+
 @numba.njit(cache=True, inline="always")
 def voigt_to_mat(s, out):
     """Symmetric tensor from Voigt order (xx, yy, zz, yz, xz, xy)."""
