@@ -228,24 +228,24 @@ class Simulation:
 
     def check_finite(self):
         """Raise :class:`Unstable` on every rank if any owned u, v or stress is NaN/Inf,
-        or an unbroken bond stretches by more than its length in one step
-        (|v_j - v_i| dt > |xi|, kernels.runaway: an instability that the failure
-        models keep finite by zeroing stresses; Galilean-invariant, so a body in
-        rigid motion at any speed passes), naming the first bad point (lowest
+        or a family pair moves apart or together by more than its reference
+        distance in one step (|v_j - v_i| dt > |xi|, kernels.runaway: an
+        instability that the failure models keep finite by zeroing stresses;
+        Galilean-invariant, so a body in rigid motion at any speed passes), naming the first bad point (lowest
         gid) over all ranks.  The ghosts' v are refreshed first, so the test sees
         the same velocities on any number of ranks."""
         n = self.points.n_owned
         bad = None
         self.halo.exchange(self.v)
         fam = self.families
-        g = runaway.first_runaway(fam.offsets, fam.nbr, fam.broken, self.points.x, self.v,
+        g = runaway.first_runaway(fam.offsets, fam.nbr, self.points.x, self.v,
                                   self.points.gid, self.dt)
         fast = np.flatnonzero(self.points.gid[:n] == g) if g >= 0 else np.empty(0, np.int64)
         for name, rows in (
                 ("u", np.flatnonzero(~np.all(np.isfinite(self.u[:n]), axis=1))),
                 ("v", np.flatnonzero(~np.all(np.isfinite(self.v[:n]), axis=1))),
                 ("stress", np.flatnonzero(~np.all(np.isfinite(self.corr.sigma), axis=1))),
-                ("bond rate |v_j - v_i| dt > |xi|", fast)):
+                ("relative speed |v_j - v_i| dt > |xi|", fast)):
             if len(rows):
                 i = rows[0]
                 cand = (int(self.points.gid[i]), name, tuple(self.points.x[i]))
