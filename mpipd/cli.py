@@ -142,7 +142,6 @@ def _run(args, team, signals=None) -> int:
     from . import scene as sc
     from .decomp import DecompositionError
     from .geometry import check_parts
-    from .output import n_frames
     from .report import stable_dt
     from .schema import SceneError
     from .solver import Simulation
@@ -174,8 +173,7 @@ def _run(args, team, signals=None) -> int:
             if n_steps < info.step:
                 raise UsageError(f"the run length ({n_steps} steps) ends before the "
                                  f"checkpoint's step {info.step}")
-            _on_root(team, rundir.check_restart, out, info.run_id, text, info.n_points)
-            _on_root(team, rundir.check_layout, h5, n_frames(n_steps, scene.output.every),
+            _on_root(team, rundir.check_restart, out, info.run_id, text, info.n_points,
                      scene.output.every, scene.time.dt)
         else:
             _on_root(team, rundir.check_new_run, out, args.overwrite)

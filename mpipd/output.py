@@ -111,7 +111,7 @@ class Writer:
         """Create the run file for run ``run_id`` — or, with ``resume``, reopen it and
         continue after the frames up to the simulation's current step (restart).
         A restart may change the run length: the frame and probe datasets grow or
-        shrink along their first axis (mpipd.rundir.check_layout refuses the rest)."""
+        shrink along their first axis (mpipd.rundir.check_restart refuses the rest)."""
         import h5py
         self.path = Path(path)
         self.sim = sim

@@ -50,7 +50,6 @@ class RunFile:
     run_id: str | None
     scene: str
     n_points: int
-    n_frames: int
     every: int
     dt: float
 
@@ -60,10 +59,9 @@ def read_run_file(h5: Path) -> RunFile:
     try:
         with h5py.File(h5, "r") as f:
             a = f.attrs
-            frames = f["time"].shape[0] if "time" in f else 0
-            every = int(a["every"]) if "every" in a else -1
             return RunFile(str(a["run_id"]) if "run_id" in a else None, str(a.get("scene", "")),
-                           int(a.get("n_points", -1)), frames, every, float(a.get("dt", 0.0)))
+                           int(a.get("n_points", -1)), int(a.get("every", -1)),
+                           float(a.get("dt", 0.0)))
     except (OSError, KeyError, ValueError) as e:
         raise RunDirError(f"{h5}: cannot read the run file ({e})") from None
 
@@ -81,10 +79,13 @@ def check_new_run(out: Path, overwrite: bool) -> None:
 OVERRIDES_MARK = "\n# overrides (--set)\n"
 
 
-def check_restart(out: Path, ck_run_id: str | None, scene_text: str, n_points: int) -> None:
+def check_restart(out: Path, ck_run_id: str | None, scene_text: str, n_points: int,
+                  every: int, dt: float) -> None:
     """A restart from a checkpoint of run ``ck_run_id`` into ``out``: the run file
-    there must be that run's: the same run id, scene TOML (``scene_text``, without
-    overrides: a restart may add some) and point count ``n_points``."""
+    there must be that run's (the same run id, scene TOML ``scene_text`` without
+    overrides -- a restart may add some -- and point count ``n_points``), and the
+    frame layout must stay: a restart may change the run length, not the frame
+    spacing ``every`` or the step ``dt``, since frames are indexed by step // every."""
     if out.exists() and not out.is_dir():
         raise RunDirError(f"--out {out} exists and is not a directory")
     h5 = out / RUN_FILE
@@ -102,20 +103,11 @@ def check_restart(out: Path, ck_run_id: str | None, scene_text: str, n_points: i
     if rf.n_points != n_points or rf.scene.split(OVERRIDES_MARK)[0] != scene_text:
         raise RunDirError(f"{h5} has the checkpoint's run id but another scene or point count "
                           "(edited by hand?); refusing to write into it")
-
-
-def check_layout(h5: Path, n_frames: int, every: int, dt: float) -> None:
-    """A restart may change the run length (time.steps / time.t_end), not the frame
-    spacing or the time step: frames are indexed by step // every."""
-    rf = read_run_file(h5)
-    if rf.every not in (-1, every):
+    if rf.every != every:
         raise RunDirError(f"a restart cannot change output.every ({rf.every} -> {every}): "
                           "the frames in the run file are indexed by step")
-    if rf.dt and rf.dt != dt:
+    if rf.dt != dt:
         raise RunDirError(f"a restart cannot change time.dt ({rf.dt:g} -> {dt:g} s)")
-    if rf.every == -1 and rf.n_frames != n_frames:
-        raise RunDirError(f"{h5} was sized for another run length (written by an older mpipd "
-                          "whose run files cannot grow)")
 
 
 def ensure_writable(out: Path) -> None:
