@@ -11,7 +11,10 @@
 Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
 sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
-zone, and the median for the count of major radial cracks.
+zone, and the median for the count of major radial cracks.  The lattice bias
+(:mod:`postprocess.lattice_bias`: 4- and 8-fold Fourier amplitudes of the failed
+points' angles in the zone-2 ring) is measured on every gathered section at the
+last frame.
 
 Peaks (gas, wall, PPV profile) are over every step (:mod:`postprocess.peaks`, the
 probes), never over the saved frames alone; impossible values are gathered in
@@ -21,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import cracks, errors, explosive, ledger, peaks, probe_metrics as pm, sections as secs
-from . import volume
+from . import cracks, errors, explosive, lattice_bias, ledger, peaks, probe_metrics as pm
+from . import sections as secs, volume
 from .targets import TARGETS, verdict
 
 CRACK_SECTIONS = (secs.NAMED[0], secs.NAMED[2], secs.NAMED[4])
@@ -74,6 +77,19 @@ def _fracture(data_sections, model, last) -> dict:
                 [out[n]["crushed_zone"]["extent_borehole_radii"] for n in names])),
             "crushed_extent_mm": float(np.mean([out[n]["crushed_zone"]["extent_mm"]
                                                 for n in names]))}
+
+
+def _lattice_bias(data_sections, model, last) -> dict:
+    out = {}
+    for name, z in data_sections["levels"].items():
+        sec = data_sections["sections"][z]
+        try:
+            failed, _ = cracks.failed_points(sec, last)
+        except KeyError as e:
+            return {"not_available": str(e).strip("'\"")}
+        out[name] = lattice_bias.measure(sec["x"], sec["y"], failed, model.center, model.dx,
+                                         model.r_wall, model.r_out, horizon=model.horizon)
+    return {**out, "ring": lattice_bias.RING}
 
 
 def _ppv_radius(ppv, profile) -> dict:
@@ -136,6 +152,8 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     metrics["global_energy_J"] = metrics["energy_ledger"].get("series_J", {})
     fr = _fracture(sec_data, model, last) if run.root else None
     metrics["fracture"] = run.comm.bcast(fr, root=0)
+    lb = _lattice_bias(sec_data, model, last) if run.root else None
+    metrics["lattice_bias"] = run.comm.bcast(lb, root=0)
     metrics["ppv_radius"] = _ppv_radius(metrics["ppv"], metrics["ppv_profile"])
     metrics["errors"] = errors.collect(metrics, probes)
     metrics["targets"] = targets_table(metrics)

@@ -87,6 +87,7 @@ def render(doc) -> str:
         ", ".join(f"{k} {v}" for k, v in fm.items() if k != "note")) + ".", ""]
     L += _fig(doc, "fig13_failure_modes")
     L += _fracture(doc["fracture"]) + _fig(doc, "fig12_crack_density")
+    L += _lattice_bias(doc["lattice_bias"])
     L += _probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _energy(doc)
     na = [f"- {r['label']}: {r['verdict'][len('not available: '):]}" for r in doc["targets"]
           if r["verdict"].startswith("not available")]
@@ -138,6 +139,32 @@ def _fracture(fr) -> list[str]:
           f"{fr['crushed_extent_borehole_radii']:.2f} |",
           "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", ""]
     return L
+
+
+def _lattice_bias(lb) -> list[str]:
+    L = ["## Lattice bias (issue 15)", ""]
+    if _na(lb):
+        return L + [f"Not available: {lb['not_available']}.", ""]
+    L += [f"Ring: {lb['ring']}.  a_m = |c_m|/c_0, the m-fold Fourier amplitude of the failed "
+          "fraction against the angle, with the lattice's own angular density of points "
+          "subtracted (0 for an isotropic pattern; 1 for thin cracks on the axes or on the "
+          "diagonals only); noise = the mean a_m of as many failed points placed regardless "
+          "of angle (`postprocess/lattice_bias.py`).", "",
+          "| section | ring (mm) | failed points | a_4 | a_8 | noise | a_4 / noise | "
+          "4-fold direction (deg; 0 axes, 45 diagonals) | major radial cracks |",
+          "|---|---|---|---|---|---|---|---|---|"]
+    for name, s in lb.items():
+        if name == "ring":
+            continue
+        if _na(s):
+            L.append(f"| {name} | not available: {s['not_available']} | | | | | | | |")
+            continue
+        ratio = s["a4"] / s["noise"] if s["noise"] > 0 else None
+        L.append(f"| {name} | {s['ring_mm'][0]:.3g}–{s['ring_mm'][1]:.3g} | {s['n_failed']} of "
+                 f"{s['n_points']} | {s['a4']:.3f} | {s['a8']:.3f} | {s['noise']:.3f} | "
+                 f"{_f(ratio, '.1f')} | {s['a4_direction_deg']:.0f} | "
+                 f"{s['major_radial_cracks']} |")
+    return L + [""]
 
 
 def _radial(doc) -> list[str]:

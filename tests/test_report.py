@@ -254,6 +254,32 @@ def test_radial_cracks_and_crushed_zone(tmp_path):
     assert row["crushed_zone"]["verdict"] == "within"
 
 
+def test_lattice_bias_of_a_cross_on_every_section(tmp_path):
+    """A cross along the axes (|x| or |y| < 2 dx, 4 rows of 9 points per arm in the
+    zone-2 ring 12-21 mm): a_4 ~ 0.96, far above the noise; 4 major cracks; report.md
+    shows the table.  Without a failed point in the ring: not available per section."""
+    from postprocess.report_md import _lattice_bias
+    x, part = lattice()
+    cross = (part == 1) & ((np.abs(x[:, 0]) < 2 * DX) | (np.abs(x[:, 1]) < 2 * DX))
+    write_run(tmp_path / "run.h5", failed=cross)
+    m, _ = analyse(tmp_path / "run.h5")
+    lb = m["lattice_bias"]
+    assert set(lb) == set(m["sections_mm"]) | {"ring"} and "zone 2" in lb["ring"]
+    for name, s in lb.items():
+        if name == "ring":
+            continue
+        assert s["ring_mm"] == pytest.approx([12.0, 21.0])
+        assert s["n_failed"] == 144 and s["major_radial_cracks"] == 4
+        assert s["a4"] == pytest.approx(0.96, abs=0.01) and s["a4"] > 10 * s["noise"]
+    for name, sec in m["fracture"]["sections"].items():        # the same ring as zone 2
+        assert sec["zones"][1]["failed_points"] == lb[name]["n_failed"]
+    md = "\n".join(_lattice_bias(lb))
+    assert "| mid-thickness | 12–21 | 144 of " in md
+    write_run(tmp_path / "none.h5")
+    m, _ = analyse(tmp_path / "none.h5")
+    assert all("not_available" in s for k, s in m["lattice_bias"].items() if k != "ring")
+
+
 def test_wave_speed_attenuation_and_ppv_from_probes(tmp_path):
     """A pulse of peak C d^-0.8 travelling at 4000 m/s gives back the speed and the
     exponent; the PPV law d^-1.2 gives beta = 1.2."""
