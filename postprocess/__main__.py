@@ -1,4 +1,5 @@
-"""``mpirun -n N python -m postprocess {summary | wave-speed | fracture | report | compare} RUN.h5``
+"""``mpirun -n N python -m postprocess {summary | wave-speed | fracture | report | compare |
+validate} RUN.h5``
 
 summary      points, frames, time span, energy drift (or the ledger's largest |balance|),
              peak |v| per frame
@@ -11,6 +12,10 @@ report       the paper's figures (Figs. 7, 9, 11-13, 15-18, 20) of one run and a
              validation report: report.md and report.json in --out (postprocess.report)
 compare      several runs side by side: compare.md/.json and the fracture patterns,
              rock energy and peak radial stress of all runs in one figure each
+validate     the validation record (issue 15): OUT.md with every run's provenance, one
+             table of the targets (a value and verdict column per run), key figures and
+             report.json copied into OUT/<case>/ (postprocess.validation); a run file or
+             run folder is reported first
 
 A file that is not a readable mpipd run file gives one line on stderr and exit status 2.
 """
@@ -169,8 +174,20 @@ def main(argv=None) -> int:
     cp.add_argument("--view", default="detonation-face",
                     choices=["detonation-face", "mid", "far-face"],
                     help="section of the fracture figure (Figs. 19, 22 view the detonation side)")
+    va = sub.add_parser("validate", help="the validation record of several runs")
+    va.add_argument("runs", nargs="+", metavar="RUNDIR_OR_REPORT",
+                    help="a report directory (report.json + figures), a run folder or run.h5 "
+                         "(reported first, into report/ beside the run file)")
+    va.add_argument("--out", default="docs/validation",
+                    help="directory of the per-run files; the record is OUT.md beside it "
+                         "(default: docs/validation -> docs/validation.md)")
+    va.add_argument("--notes", default=None, help="hand-written diagnoses (markdown), inserted "
+                    "verbatim under 'Diagnoses'")
+    va.add_argument("--check", action="store_true",
+                    help="only check that every input exists (exit 2 naming what is missing)")
     args = ap.parse_args(argv)
-    if args.cmd in ("report", "compare"):
+    args.argv = list(sys.argv[1:] if argv is None else argv)
+    if args.cmd in ("report", "compare", "validate"):
         return _guarded(comm, _analysis_cmd, args, comm)
     try:
         run = Run(args.run, comm)
@@ -211,6 +228,12 @@ def _analysis_cmd(args, comm) -> list[str]:
         out = args.out or str(Path(args.run).resolve().parent / "report")
         times = [float(t) for t in args.times.split(",")] if args.times else None
         return make_report(args.run, out, comm, times)
+    if args.cmd == "validate":
+        from .validation import InputError, make_validation
+        try:
+            return make_validation(args.runs, args.out, comm, args.notes, args.argv, args.check)
+        except InputError as e:
+            raise UsageError(str(e)) from None
     from .compare import make_compare
     labels = args.labels.split(",") if args.labels else None
     if labels and len(labels) != len(args.runs):

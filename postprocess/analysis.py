@@ -232,12 +232,19 @@ def _bases(m: dict) -> dict:
     return out
 
 
+def target_bounds(m: dict) -> dict:
+    """key -> (lo, hi) of the consistency rows, from the run's own explosive_reference
+    (also applied to a report.json by :mod:`postprocess.validation`)."""
+    ref = m["explosive_reference"]
+    return {"peak_gas_pressure": tuple(ref["consistency_MPa"])
+            if "consistency_MPa" in ref else None}
+
+
 def targets_table(m: dict) -> list[dict]:
     vals = target_values(m)
     bases = _bases(m)
     ref = m["explosive_reference"]
-    bounds = {"peak_gas_pressure": tuple(ref["consistency_MPa"])
-              if "consistency_MPa" in ref else None}
+    bounds = target_bounds(m)
     band = {"peak_gas_pressure": explosive.band_text(ref)}
     rows = []
     for t in TARGETS:

@@ -1,0 +1,19 @@
+# `make validate`: the validation record (issue 15), docs/validation.md with
+# docs/validation/<case>/ (each run's report.json and key figures), re-created from
+# the run files in VALIDATE_RUNS: each is reported again (python -m postprocess report,
+# into report/ beside it) and the record is written from those report.json files,
+# with the hand-written diagnoses of VALIDATE_NOTES (if the file exists) verbatim.
+# A missing run file stops it first with one line naming the file and the command
+# that makes it (exit status 2), before anything is written.
+#   make validate VALIDATE_RUNS="runs/demo/run.h5"      # another set of runs
+.PHONY: validate
+
+VALIDATE_RUNS ?= runs/blast_paper_dx1.2/run.h5 runs/demo/run.h5
+VALIDATE_OUT ?= docs/validation
+VALIDATE_NOTES ?= docs/validation_notes.md
+VALIDATE_RANKS ?= 2
+
+validate: install
+	@$(PY) -m postprocess validate --check $(VALIDATE_RUNS)
+	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
+	    $(VALIDATE_RUNS) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES))

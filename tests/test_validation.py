@@ -1,0 +1,230 @@
+"""postprocess validate: the validation record from synthetic report directories
+(report.json in the layout of `postprocess report`, tiny PNGs) with known values —
+one table row per target, values and verdicts in their run's columns, figures
+copied and downscaled, the lattice-bias table when a report has one, the notes
+verbatim, and a missing input: one line, exit status 2, nothing written."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import ROOT, child_env
+from PIL import Image
+
+from postprocess import validation
+from postprocess.__main__ import main
+from postprocess.targets import TARGETS, verdict
+
+CONSISTENCY = (6794.0, 15511.0)
+BIG, SMALL = (1800, 600), (300, 200)        # figure sizes (px): one wider than 900
+
+
+def inside(t):
+    """A value within target t's range (information rows: any number)."""
+    if t.kind == "consistency":
+        return 9000.0
+    if t.lo is None and t.hi is None:
+        return 4100.0
+    return t.lo if t.hi is None else t.hi if t.lo is None else 0.5 * (t.lo + t.hi)
+
+
+def outside(t):
+    if t.kind == "consistency":
+        return 20000.0
+    if t.lo is None and t.hi is None:
+        return 3900.0
+    if t.unit == "yes/no":
+        return 1.0 - t.lo
+    return (t.hi + 1.0) if t.hi is not None else t.lo - 1.0
+
+
+def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces",
+                                                          "fig12_crack_density")):
+    """A report.json like `postprocess report` writes (only the blocks the record reads,
+    in their layout): ``values`` key -> number, or a string = the not-available reason."""
+    rows = []
+    for t in TARGETS:
+        v = values[t.key]
+        judged = {"not_available": v} if isinstance(v, str) else v
+        rows.append({"key": t.key, "label": t.label, "unit": t.unit, "kind": t.kind,
+                     "value": None if isinstance(v, str) else float(v),
+                     "basis": "3 probes" if t.key == "wave_speed" else "",
+                     "paper": t.paper, "experiment": t.experiment, "band": t.band,
+                     "verdict": verdict(t.key, judged, CONSISTENCY)})
+    doc = {"run": {"run_file": f"/somewhere/runs/{case}/run.h5", "label": f"blast_demo ({case})",
+                   "n_points": 12345, "run_ranks": 3, "dt_s": 2e-08, "steps": 600,
+                   "git_commit": "0123456789abcdef0123456789abcdef01234567",
+                   "mpipd_version": "0.1.0", "fields": ["damage"], "bonds_broken": 77,
+                   "run_id": f"id-{case}", "n_bonds": 999, "save_every": 100},
+           "errors": [], "figures": {f: f + ".png" for f in figures},
+           "figures_not_made": {"fig18_ppv": "the run has no peak_speed field"},
+           "model": {"scene": "blast_demo", "dx_m": 0.001, "overrides": [], "notes": []},
+           "frames": 7, "t_end_us": 12.0,
+           "explosive_reference": {"consistency_MPa": list(CONSISTENCY)}, "targets": rows}
+    if lattice_bias is not None:
+        doc["lattice_bias"] = lattice_bias
+    return doc
+
+
+def write_report(d: Path, doc, sizes=(BIG, SMALL)):
+    d.mkdir(parents=True)
+    (d / "report.json").write_text(json.dumps(doc, indent=1))
+    for (name, f), size in zip(doc["figures"].items(), sizes):
+        Image.new("RGBA", size, (200, 30, 30, 255)).save(d / f)
+    return d
+
+
+BIAS = {"detonation_face": {"ring_mm": [10.0, 25.0], "n_failed": 321, "a4": 0.41,
+                            "a8": 0.12, "noise": 0.05, "major_radial_cracks": 4},
+        "mid": {"ring_mm": [10.0, 25.0], "n_failed": 200, "a4": 0.33, "a8": 0.07,
+                "noise": 0.04, "major_radial_cracks": 6},
+        "ring": "failed points with 10 mm < r < 25 mm"}
+
+
+@pytest.fixture()
+def two_reports(tmp_path):
+    good = {t.key: inside(t) for t in TARGETS}
+    bad = {t.key: outside(t) for t in TARGETS}
+    bad["peak_sigma_rr_G"] = "no probe G"
+    a = write_report(tmp_path / "in" / "alpha" / "report",
+                     report_json("alpha", good, lattice_bias=BIAS))
+    b = write_report(tmp_path / "in" / "beta" / "report", report_json("beta", bad))
+    return tmp_path, a, b, good, bad
+
+
+def table(md: str, heading: str) -> list[list[str]]:
+    """The rows (cells) of the first table after ``heading``."""
+    part = md.split(heading, 1)[1]
+    lines = [ln for ln in part.split("\n## ", 1)[0].splitlines() if ln.startswith("|")]
+    return [[c.strip() for c in ln.strip("|").split(" | ")] for ln in lines]
+
+
+def test_record(two_reports, capsys):
+    tmp, a, b, good, bad = two_reports
+    out = tmp / "docs" / "validation"
+    notes = tmp / "notes.md"
+    notes.write_text("### Why zone 3 is high\n\nThe *lattice* bias, see `fig09`.\n")
+    rc = main(["validate", "--out", str(out), str(a), str(b), "--notes", str(notes)])
+    assert rc == 0, capsys.readouterr().err
+    md = (tmp / "docs" / "validation.md").read_text()
+    assert md.startswith("# Validation record")
+    assert f"`python -m postprocess validate --out {out} {a} {b} --notes {notes}`" in md
+
+    rows = table(md, "## Targets")
+    head, body = rows[0], rows[2:]
+    assert head == ["quantity", "unit", "paper", "experiment", "range used",
+                    "alpha", "alpha verdict", "beta", "beta verdict"]
+    assert len(body) == len(TARGETS)
+    for t, row in zip(TARGETS, body):
+        assert row[0] == t.label and row[1] == t.unit and row[2] == t.paper
+        assert row[3] == t.experiment
+        va, vb = good[t.key], bad[t.key]
+        if t.unit == "yes/no":
+            assert row[5] == ("yes" if va else "no") and row[7] == ("yes" if vb else "no")
+        else:
+            assert row[5].split(" (")[0] == validation.number(va)
+        want_a = "information" if t.kind == "information" else "**within**"
+        want_b = "information" if t.kind == "information" else "**outside**"
+        assert row[6] == want_a, t.key
+        if t.key == "peak_sigma_rr_G":
+            assert row[7] == "—" and row[8] == "not available: no probe G"
+        else:
+            assert row[8] == want_b, t.key
+            if t.unit != "yes/no":
+                assert row[7].split(" (")[0] == validation.number(vb)
+    assert body[0][5] == f"{good['wave_speed']:.4g} (3 probes)"
+    gas = [r for t, r in zip(TARGETS, body) if t.key == "peak_gas_pressure"][0]
+    assert gas[7] == "20000" and gas[8] == "**outside**"
+
+    prov = {r[0]: r[1:] for r in table(md, "## Provenance")}
+    assert prov["points"] == ["12345", "12345"] and prov["ranks"] == ["3", "3"]
+    assert prov["run id"] == ["id-alpha", "id-beta"]
+    assert prov["run wall time"] == ["not recorded", "not recorded"]
+    assert prov["throughput"] == ["not recorded", "not recorded"]
+
+    bias = table(md, "## Lattice bias")
+    assert bias[0][:3] == ["run", "section", "ring (mm)"]
+    assert bias[2] == ["alpha", "detonation_face", "10–25", "321", "0.41", "0.12", "0.05", "4"]
+    assert bias[3][:2] == ["alpha", "mid"] and len(bias) == 4       # beta has none
+    assert "failed points with 10 mm < r < 25 mm" in md
+    assert "No lattice_bias in the report.json of: beta." in md
+
+    assert md.rstrip().endswith(notes.read_text().rstrip())
+    assert "## Diagnoses\n\n### Why zone 3 is high\n" in md
+
+    for case, src in (("alpha", a), ("beta", b)):
+        d = out / case
+        assert (d / "report.json").read_bytes() == (src / "report.json").read_bytes()
+        big = Image.open(d / "fig09_fracture_faces.png")
+        small = Image.open(d / "fig12_crack_density.png")
+        assert big.size == (900, 300) and small.size == SMALL
+        assert f"](validation/{case}/fig09_fracture_faces.png)" in md
+        assert not (d / "fig18_ppv.png").exists()
+    assert "not made: the run has no peak_speed field" in md
+
+
+def test_changed_verdict_is_flagged(tmp_path, capsys):
+    """A verdict stored in report.json that targets.verdict no longer gives (the bands
+    changed since the report) is shown beside the current one."""
+    doc = report_json("old", {t.key: inside(t) for t in TARGETS})
+    doc["targets"][2]["verdict"] = "outside"
+    d = write_report(tmp_path / "old" / "report", doc)
+    assert main(["validate", "--out", str(tmp_path / "v" / "validation"), str(d)]) == 0
+    md = (tmp_path / "v" / "validation.md").read_text()
+    row = table(md, "## Targets")[2 + 2]
+    assert row[0] == TARGETS[2].label and row[6] == "**within** (report.json: outside)"
+
+
+def test_without_lattice_bias_and_notes(two_reports, capsys):
+    tmp, a, b, *_ = two_reports
+    out = tmp / "v" / "validation"
+    assert main(["validate", "--out", str(out), str(b)]) == 0
+    md = (tmp / "v" / "validation.md").read_text()
+    assert "## Lattice bias" not in md
+    assert "No notes were given" in md
+    assert len(table(md, "## Targets")) == 2 + len(TARGETS)
+
+
+def test_missing_input_writes_nothing(two_reports, capsys):
+    tmp, a, *_ = two_reports
+    out = tmp / "docs" / "validation"
+    missing = tmp / "runs" / "blast_paper_dx1.2" / "run.h5"
+    capsys.readouterr()
+    assert main(["validate", "--out", str(out), str(a), str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert str(missing) in err
+    assert f"mpirun -n 2 mpipd run blast_paper:dx1.2 --out {missing.parent}" in err
+    assert not (tmp / "docs").exists()
+    assert main(["validate", "--out", str(out), str(tmp / "in")]) == 2       # no report.json
+    assert "neither report.json nor run.h5" in capsys.readouterr().err
+    assert main(["validate", "--out", str(out), str(a), "--notes", str(tmp / "nope.md")]) == 2
+    assert not (tmp / "docs").exists()
+
+
+def test_how_to_make():
+    f = validation.how_to_make
+    assert f(Path("runs/demo/run.h5")) == "make demo"
+    assert f(Path("runs/blast_paper_dx1.2/run.h5")) == \
+        "mpirun -n 2 mpipd run blast_paper:dx1.2 --out runs/blast_paper_dx1.2"
+    assert f(Path("runs/blast_demo-graded/run.h5")) == \
+        "mpirun -n 2 mpipd run blast_demo:graded --out runs/blast_demo-graded"
+    assert f(Path("runs/blast_slice/run.h5")) == \
+        "mpirun -n 2 mpipd run blast_slice --out runs/blast_slice"
+    assert "SCENE[:CASE]" in f(Path("elsewhere/mine/run.h5"))
+
+
+def test_make_validate_missing_run(tmp_path):
+    """`make validate` with a missing run file: the command's one line, exit status 2."""
+    env = child_env()
+    env["PYTHONPATH"] = str(ROOT)
+    missing = tmp_path / "runs" / "blast_paper_dx1.2" / "run.h5"
+    p = subprocess.run(["make", "-s", "-o", "install", "validate", f"PY={sys.executable}",
+                        f"VALIDATE_RUNS={missing}", f"VALIDATE_OUT={tmp_path}/docs/validation"],
+                       cwd=ROOT, capture_output=True, text=True, timeout=120, env=env)
+    assert p.returncode == 2
+    lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("make")]
+    assert len(lines) == 1 and str(missing) in lines[0]
+    assert "mpipd run blast_paper:dx1.2" in lines[0]
+    assert not (tmp_path / "docs").exists()
