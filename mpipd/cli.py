@@ -258,6 +258,14 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
                                    every=scene.output.checkpoint_every,
                                    stop_after=args.stop_after, run_id=run_id)
     checkpointer.install_signals(signals)
+    first = sim.step_count
+    wall = 0.0
+
+    def segment():
+        done = sim.step_count - first
+        return {"from_step": first, "to_step": sim.step_count, "ranks": team.size,
+                "wall_s": round(wall, 3),
+                "bond_steps_per_s": sim.n_bonds_global * done / wall if wall > 0 else None}
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
                        checkpointer=checkpointer)
@@ -265,7 +273,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         writer.close()
         log(f"mpipd: error: {e}; state saved in {checkpointer.written}", error=True)
         return EXIT_UNSTABLE
-    writer.close()
+    writer.close(segment())
     if sim.step_count == n_steps:
         checkpointer.at_end()
     if sim.step_count < n_steps:

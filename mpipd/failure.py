@@ -64,7 +64,7 @@ class Failure:
             own = items < p.n_owned
             cand = np.unique(items[own])
             before = self.corr.potentials(cand, u) if self.ledger is not None else None
-            self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx,
+            self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx, p.material,
                                              fam.offsets, fam.nbr, fam.broken, self.touched)
             changed = np.flatnonzero(self.touched)
             if len(changed):

@@ -28,6 +28,7 @@ of ParaView 5.11's XDMF readers load it (``XDMFReader``, ``Xdmf3ReaderS``,
 """
 from __future__ import annotations
 
+import json
 import subprocess
 from pathlib import Path
 
@@ -121,6 +122,7 @@ class Writer:
         self.n_frames = n_frames(n_steps, self.every)
         self.frame_no = 0
         comm = sim.team.comm
+        self.commit = sim.team.bcast(git_commit() if sim.team.root else None)
         if resume:
             self.f = h5py.File(self.path, "r+", driver="mpio", comm=comm)
             self.run_id = str(self.f.attrs["run_id"])
@@ -145,7 +147,7 @@ class Writer:
         a["scene"] = scene_text
         a["scene_name"] = scene.name
         a["mpipd_version"] = __version__
-        a["git_commit"] = sim.team.bcast(git_commit() if sim.team.root else None)
+        a["git_commit"] = self.commit
         a["ranks"] = sim.team.size
         a["dt"] = sim.dt
         a["steps"] = n_steps
@@ -205,9 +207,17 @@ class Writer:
         self.f.attrs["frames_written"] = self.frame_no
         self.f.flush()                  # a crash loses at most the frames since this one
 
-    def close(self):
+    def close(self, segment: dict | None = None):
+        """Finish the file.  ``segment`` (this invocation's first and last step, ranks,
+        loop wall time, throughput) is appended to the JSON list attr ``segments``
+        with the commit that ran it, so a run's cost survives its restarts."""
         if self.sim.probes is not None:
             self.sim.probes.flush()
+        if segment is not None:
+            old = self.f.attrs.get("segments", "[]")
+            segs = json.loads(old if isinstance(old, str) else old.decode())
+            segs.append({**segment, "git_commit": self.commit})
+            self.f.attrs["segments"] = json.dumps(segs)
         self.f.attrs["frames_written"] = self.frame_no
         self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()

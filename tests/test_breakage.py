@@ -7,8 +7,9 @@ from mpipd.kernels.breakage import break_bonds, pd_damage
 DX = 1e-3
 
 
-def run(points, bonds, failed, dx=DX):
-    """points: (n, 3) in units of DX; bonds: list of (i, j) for owned i (all points owned).
+def run(points, bonds, failed, dx=DX, material=None):
+    """points: (n, 3) in units of DX; bonds: list of (i, j) for owned i (all points owned);
+    dx: one spacing or one per point; material: one id per point (default all 0).
     Returns the set of broken (i, j)."""
     x = np.asarray(points, float) * DX
     n = len(x)
@@ -23,7 +24,9 @@ def run(points, bonds, failed, dx=DX):
     touched = np.zeros(n, np.uint8)
     pk = np.array([k for k in failed for i in range(n)], np.int64)
     pi = np.array([i for k in failed for i in range(n)], np.int64)
-    break_bonds(pk, pi, x, gid, np.full(n, dx), offsets, nbr, broken, touched)
+    mat = np.zeros(n, np.int32) if material is None else np.asarray(material, np.int32)
+    dxs = np.broadcast_to(np.asarray(dx, float), (n,)).copy()
+    break_bonds(pk, pi, x, gid, dxs, mat, offsets, nbr, broken, touched)
     return {b for b, flag in zip(bonds, broken) if flag}, touched
 
 
@@ -80,3 +83,37 @@ def test_pd_damage_eq39():
     phi = np.zeros(1)
     pd_damage(np.array([0], np.int64), offsets, nbr, broken, vol, phi)
     assert phi[0] == pytest.approx(1 - (2.0 + 4.0) / (1 + 2 + 3 + 4))
+
+
+def test_a_coarse_failed_point_breaks_no_bond_of_another_material():
+    """The paper's tube wall in miniature: a coarse rock point k (dx_k = 4 fine
+    spacings, so its dx_k / 2 ball reaches 2 spacings) fails next to a line of fine
+    copper points.  The copper-copper bonds passing within dx_k / 2 of x_k lie in
+    the copper and stay intact; the copper-rock bonds crossing the ball (rule b)
+    and k's own bonds (rule a) break, as does a rock-rock bond through the ball."""
+    cu = [(i, 0, 0) for i in range(5)]                 # copper, material 1, dx 1
+    k = (2, 1.5, 0)                                    # failed rock point, 1.5 from the line
+    rock = [(2, 5.5, 0), (-2, 1.5, 0), (6, 1.5, 0)]    # rock, material 2, dx 4
+    pts = cu + [k] + rock
+    mat = [1] * 5 + [2] * 4
+    dx = np.array([1.0] * 5 + [4.0] * 4) * DX
+    K, R0, R1, R2 = 5, 6, 7, 8
+    cc = [(i, j) for i in range(5) for j in range(5) if i != j]
+    crk = [(i, R0) for i in range(5)] + [(R0, i) for i in range(5)]   # copper-rock, far side
+    kb = [(K, i) for i in range(5)] + [(i, K) for i in range(5)]      # k's own bonds
+    rr = [(R1, R2), (R2, R1)]                                          # rock-rock through k
+    broken, _ = run(pts, cc + crk + kb + rr, failed=[K], dx=dx, material=mat)
+    assert not (broken & set(cc)), "copper's own bonds must survive a rock failure"
+    assert set(kb) <= broken and set(rr) <= broken
+    # copper i -> rock R0 at (2, 5.5): the segment from (i, 0) passes within 2 of k
+    # only for i = 1, 2, 3 (distance from (2, 1.5) to the segment, computed here)
+    def dist(a, b, q):
+        a, b, q = map(np.asarray, (a, b, q))
+        t = np.clip(np.dot(q - a, b - a) / np.dot(b - a, b - a), 0, 1)
+        return np.linalg.norm(a + t * (b - a) - q)
+    want = {(i, R0) for i in range(5) if dist(cu[i], rock[0], k) <= 2.0}
+    want |= {(R0, i) for (i, _) in want}
+    assert want and broken & set(crk) == want
+    # without the material condition (all one material) the copper bonds near k break
+    broken1, _ = run(pts, cc, failed=[K], dx=dx)
+    assert broken1 & set(cc)

@@ -2,7 +2,20 @@
 
 When point k fails, a bond (i, j) breaks if
   (a) it touches k (i == k or j == k), or
-  (b) its reference segment passes within dx_k / 2 of x_k.
+  (b) its reference segment passes within dx_k / 2 of x_k, and i or j is of k's
+      material.
+
+The material condition in (b) is mpipd's reading of the paper's rule for a body
+of several materials at several resolutions.  The ball of radius dx_k / 2 stands
+for the volume of k, but where a coarse part meets a fine one (the 1.2 mm rock
+around the paper's 0.3 mm copper tube, 0.6 mm thick) that ball reaches across the
+interface, into the other material.  A bond between two points of another
+material lies in that other material: it does not cross k's volume, and k's
+failure (a crushed rock) is no failure of it.  Without the condition, the rock
+crushed at the borehole wall broke 8 % of the copper's own bonds (every bond
+along the tube within 0.6 mm of a failed rock point) and left 1344 of the
+20,040 copper points of the reduced paper scene with too few bonds for a shape
+tensor (README, "Bond breakage across materials").
 Both ranks holding the two directions of a bond evaluate (b) with the endpoints
 ordered by global id, so they perform the same floating-point operations and
 reach the same verdict: bond (i, j) and bond (j, i) break on the same step.
@@ -33,9 +46,10 @@ def segment_dist2(x, a, b, k):
 
 
 @numba.njit(cache=True)
-def break_bonds(pair_k, pair_i, x, gid, dx, offsets, nbr, broken, touched):
+def break_bonds(pair_k, pair_i, x, gid, dx, material, offsets, nbr, broken, touched):
     """For every (failed k, owned candidate i) pair, break i's bonds by rules (a)
-    and (b).  Sets touched[i] = 1 where a bond broke; returns the bonds broken."""
+    and (b) (``material``: every local point's material id).  Sets touched[i] = 1
+    where a bond broke; returns the bonds broken."""
     n = 0
     for p in range(pair_k.shape[0]):
         k = pair_k[p]
@@ -46,7 +60,7 @@ def break_bonds(pair_k, pair_i, x, gid, dx, offsets, nbr, broken, touched):
                 continue
             j = nbr[b]
             hit = i == k or j == k
-            if not hit:
+            if not hit and (material[i] == material[k] or material[j] == material[k]):
                 if gid[i] < gid[j]:
                     hit = segment_dist2(x, i, j, k) <= r2
                 else:
