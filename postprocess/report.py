@@ -90,7 +90,8 @@ def make_report(path, out, comm, pattern_us=None) -> list[str]:
                 "mpipd_version": str(run.attr("mpipd_version", "unknown")),
                 "fields": run.field_names, "bonds_broken": _int(run.attr("bonds_broken"))}
         info.update(run_id=run.attr("run_id"), n_bonds=_int(run.attr("n_bonds")),
-                    save_every=_int(run.attr("every")))
+                    save_every=_int(run.attr("every")),
+                    segments=json.loads(run.attr("segments", "[]")))
     finally:
         run.close()
     if comm.Get_rank() != 0:

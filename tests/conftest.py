@@ -78,3 +78,19 @@ def run_cli(args, ranks=None, timeout=300, cwd=None):
 def run_mpi_script(script, ranks, *args, timeout=300):
     cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(script), *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=child_env())
+
+
+# ------------------------------------------------------------------ long stability cases
+def pytest_addoption(parser):
+    parser.addoption("--long", action="store_true",
+                     help="also run the tests marked `long` (minutes each; make stability)")
+
+
+def pytest_collection_modifyitems(config, items):
+    if config.getoption("--long"):
+        return
+    skip = pytest.mark.skip(reason="a long stability case: run by `make stability` "
+                                   "(part of `make verify`)")
+    for item in items:
+        if "long" in item.keywords:
+            item.add_marker(skip)

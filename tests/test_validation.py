@@ -64,6 +64,12 @@ def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces"
            "explosive_reference": {"consistency_MPa": list(CONSISTENCY)}, "targets": rows}
     if lattice_bias is not None:
         doc["lattice_bias"] = lattice_bias
+    if case == "alpha":         # a run stopped at step 200 on 2 ranks, restarted on 3
+        doc["run"]["segments"] = [
+            {"from_step": 0, "to_step": 200, "ranks": 2, "wall_s": 60.0,
+             "bond_steps_per_s": 999 * 200 / 60.0, "git_commit": "0123"},
+            {"from_step": 200, "to_step": 600, "ranks": 3, "wall_s": 180.0,
+             "bond_steps_per_s": 999 * 400 / 180.0, "git_commit": "0123"}]
     return doc
 
 
@@ -140,8 +146,13 @@ def test_record(two_reports, capsys):
     prov = {r[0]: r[1:] for r in table(md, "## Provenance")}
     assert prov["points"] == ["12345", "12345"] and prov["ranks"] == ["3", "3"]
     assert prov["run id"] == ["id-alpha", "id-beta"]
-    assert prov["run wall time"] == ["not recorded", "not recorded"]
-    assert prov["throughput"] == ["not recorded", "not recorded"]
+    # alpha: 240 s over two invocations; 999 bonds x 600 steps / 240 s; per rank the
+    # time-weighted mean of (999*200/60)/2 and (999*400/180)/3 (computed here)
+    per_rank = ((999 * 200 / 60) / 2 * 60 + (999 * 400 / 180) / 3 * 180) / 240
+    assert prov["run wall time"] == ["4.0 min (2 invocation(s) on 2/3 rank(s))",
+                                     "not recorded"]
+    assert prov["throughput"] == [f"{999 * 600 / 240 / 1e6:.2f} M bond-steps/s "
+                                  f"({per_rank / 1e6:.2f} M per rank)", "not recorded"]
 
     bias = table(md, "## Lattice bias")
     assert bias[0][:3] == ["run", "section", "ring (mm)"]
