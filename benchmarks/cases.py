@@ -31,7 +31,7 @@ ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
 from mpipd import scene as sc  # noqa: E402
-from mpipd.ledger import TERMS, Energies, impossible  # noqa: E402
+from mpipd.ledger import Energies, impossible  # noqa: E402
 
 
 def finished(h5: Path) -> bool:
@@ -49,8 +49,7 @@ def summary(h5: Path, rc: int) -> dict:
         a = f.attrs
         frames = int(a.get("frames_written", 0))
         k = frames - 1
-        e = Energies(**{t: float(f["energy"][t][k]) for t in TERMS
-                        if t not in ("t", "balance")})
+        e = Energies.from_record(f["energy"], k)
         names = list(f["geometry/material"].attrs["names"])
         mat = f["geometry/material"][...]
         peak = f["fields/peak_speed"][k] if "peak_speed" in f["fields"] else None

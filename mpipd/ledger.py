@@ -110,6 +110,11 @@ class Energies:
         """Relative closure error (initial + external - held - dissipated) / scale."""
         return (self.initial + self.external - self.held - self.dissipated) / self.scale
 
+    @classmethod
+    def from_record(cls, group, frame: int = -1) -> "Energies":
+        """The reading of one frame of a run file's ``/energy`` group (h5py)."""
+        return cls(**{f.name: float(group[f.name][frame]) for f in fields(cls)})
+
     def as_dict(self) -> dict:
         d = {f.name: getattr(self, f.name) for f in fields(self)}
         d["balance"] = self.balance
