@@ -62,7 +62,8 @@ def summary(h5: Path, rc: int) -> dict:
                  if peak is not None else {})
     wall = sum(s["wall_s"] for s in segs)
     done = sum(s["to_step"] - s["from_step"] for s in segs)
-    return {"exit": rc, "last_step": last, "steps": steps, "reached_t_end": last == steps,
+    commits = sorted({sg["git_commit"][:10] for sg in segs})
+    return {"exit": rc, "commits": commits, "last_step": last, "steps": steps, "reached_t_end": last == steps,
             "wall_s": wall if segs else None, "n_points": int(len(mat)),
             "bond_steps_per_s": (sum(s["bond_steps_per_s"] * s["wall_s"] for s in segs) / wall
                                  if wall > 0 and done else None),
@@ -107,17 +108,18 @@ def main(argv=None) -> int:
     mats = sorted({m for r in rows.values() for m in r.get("peak_speed_m_s", {})})
     L = [f"# {args.scene} and its named cases to t_end", "",
          f"Made by `python benchmarks/cases.py --scene {args.scene} --ranks {args.ranks}`.", "",
-         "| case | exit | last step / steps | wall (min) | points | M bond-steps/s | "
+         "| case | commit | exit | last step / steps | wall (min) | points | M bond-steps/s | "
          "failed (JH2 plastic / JH2 tensile / tension) | ledger balance | impossible | "
          + " | ".join(f"peak speed {m} (m/s)" for m in mats) + " |",
-         "|---|---|---|---|---|---|---|---|---|" + "---|" * len(mats)]
+         "|---|---|---|---|---|---|---|---|---|---|" + "---|" * len(mats)]
     for name, r in rows.items():
         if "steps" not in r:
-            L.append(f"| {name} | {r['exit']} | no run file |" + " |" * (7 + len(mats)))
+            L.append(f"| {name} | — | {r['exit']} | no run file |" + " |" * (7 + len(mats)))
             continue
         f = r["failed_by_mode"]
         rate = r["bond_steps_per_s"]
-        L.append(f"| {name} | {r['exit']} | {r['last_step']} / {r['steps']} | "
+        L.append(f"| {name} | {', '.join(r['commits']) or 'not recorded'} | {r['exit']} | "
+                 f"{r['last_step']} / {r['steps']} | "
                  f"{'not recorded' if r['wall_s'] is None else format(r['wall_s'] / 60, '.1f')}"
                  f" | {r['n_points']} | "
                  f"{'—' if rate is None else format(rate / 1e6, '.2f')} | "
