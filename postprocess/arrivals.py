@@ -11,18 +11,26 @@
 * Wave speed: the least-squares slope of distance against first-arrival time over
   probes A–G; the arrival times must increase with distance from the wall, else the
   measure is an error, not a speed.
+* Threshold study (information): the same speed at the fractions ``STUDY`` of each
+  probe's peak.  For pulses of one shape the speed does not depend on the fraction;
+  when the pulse broadens or steepens as it travels (rise times that grow with
+  distance, a shock that steepens) the arrival at a fixed fraction is a different
+  phase of the pulse at each probe, and the speeds part.  Their spread tells how much
+  of the judged value is the measure rather than the wave.
 """
 from __future__ import annotations
 
 import numpy as np
 
 FRACTION = 0.10              # threshold = 10 % of the probe's peak -sigma_rr
+STUDY = (0.02, 0.05, 0.10, 0.20, 0.50)   # fractions of the threshold study
 PULSE_END = 0.5              # the first pulse ends below half its running maximum
 THRESHOLD_TEXT = "10 % of each probe's peak −σ_rr over its record, linearly interpolated"
 
 
-def first_arrival(t, y) -> dict:
-    """Arrival of the compressive pulse ``y`` = -sigma_rr (Pa) sampled at ``t`` (s)."""
+def first_arrival(t, y, fraction: float = FRACTION) -> dict:
+    """Arrival of the compressive pulse ``y`` = -sigma_rr (Pa) sampled at ``t`` (s), at
+    ``fraction`` of its peak."""
     t, y = np.asarray(t, float), np.asarray(y, float)
     if len(y) < 2 or not np.isfinite(y).any():
         return {"not_available": "no samples"}
@@ -30,7 +38,7 @@ def first_arrival(t, y) -> dict:
     peak = float(y[kp])
     if not peak > 0:
         return {"not_available": "no compressive pulse (−σ_rr never positive)"}
-    thr = FRACTION * peak
+    thr = fraction * peak
     k = int(np.argmax(y >= thr))
     if k == 0:
         return {"not_available": "−σ_rr is at or above the threshold at the first sample"}

@@ -173,6 +173,26 @@ def wave_speed(probes, radial: dict) -> dict:
         if "not_available" in fit:
             out["not_available"] += f"; peaks at the end of the record: {', '.join(late) or 'none'}"
     out["peak_arrival"] = _peak_arrival(pts, later)
+    out["threshold_study"] = _threshold_study(probes, [r["name"] for r in rows],
+                                              [r["d_mm"] * 1e-3 for r in rows])
+    return out
+
+
+def _threshold_study(probes, names, d) -> list[dict]:
+    """Speed from the arrivals at each fraction of ``arrivals.STUDY`` (information),
+    over the probes of the judged fit."""
+    out = []
+    for frac in arrivals.STUDY:
+        t = [arrivals.first_arrival(probes[n]["t"], -probes[n]["sigma_rr"], frac) for n in names]
+        row = {"fraction": frac}
+        if any("not_available" in a for a in t):
+            row["not_available"] = "; ".join(f"{n}: {a['not_available']}"
+                                             for n, a in zip(names, t) if "not_available" in a)
+        else:
+            fit = arrivals.speed(names, d, [a["t_s"] for a in t])
+            row.update(fit)
+            row["t_us"] = [a["t_s"] * 1e6 for a in t]
+        out.append(row)
     return out
 
 

@@ -332,6 +332,29 @@ def bias_table(runs) -> list[str]:
     return L
 
 
+def threshold_table(runs) -> list[str]:
+    """The first-arrival speed at each fraction of the probes' peaks (report.json
+    ``wave_speed.threshold_study``): how much of the judged speed is the measure."""
+    have = [r for r in runs if r["doc"].get("wave_speed", {}).get("threshold_study")]
+    if not have:
+        return []
+    fracs = [row["fraction"] for row in have[0]["doc"]["wave_speed"]["threshold_study"]]
+    L = ["## Wave speed against the arrival threshold", "",
+         "First-arrival speed (m/s) with the threshold at each fraction of every probe's "
+         "own peak −σ_rr (report.json `wave_speed.threshold_study`; the judged row uses "
+         "10 %).  Pulses that keep their shape give one speed at every fraction.", "",
+         "| run | probes | " + " | ".join(f"{f * 100:g} %" for f in fracs) + " |",
+         "|---|---|" + "---|" * len(fracs)]
+    for r in have:
+        ws = r["doc"]["wave_speed"]
+        cells = {row["fraction"]: (number(row["speed_m_s"]) if "speed_m_s" in row else
+                                   "error" if "error" in row else "n/a")
+                 for row in ws["threshold_study"]}
+        L.append(f"| {r['case']} | {', '.join(ws.get('probes', []))} | "
+                 + " | ".join(cells.get(f, "—") for f in fracs) + " |")
+    return L + [""]
+
+
 def run_section(k, r) -> list[str]:
     doc = r["doc"]
     L = [f"## Run {k}: {doc['run'].get('label', r['case'])}", "",
@@ -356,7 +379,7 @@ def render(runs, command, code_commit, notes) -> str:
          "re-creates it from the run files in `VALIDATE_RUNS` (mk/validate.mk).  Every number "
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
-    L += provenance(runs) + targets_table(runs) + bias_table(runs)
+    L += provenance(runs) + targets_table(runs) + threshold_table(runs) + bias_table(runs)
     for k, r in enumerate(runs, 1):
         L += run_section(k, r)
     L += ["## Diagnoses", ""]

@@ -514,6 +514,35 @@ def test_first_arrival_of_a_clean_wave_is_exact(tmp_path):
     off = T / math.pi * math.asin(0.1)
     for a in ws["arrivals"]:
         assert a["t_us"] == pytest.approx((t0 + d[a["name"]] / C_P + off) * 1e6, abs=2e-5)
+    study = ws["threshold_study"]
+    assert [r["fraction"] for r in study] == [0.02, 0.05, 0.10, 0.20, 0.50]
+    for r in study:                                    # one shape: one speed at every fraction
+        assert r["speed_m_s"] == pytest.approx(C_P, rel=1e-5)
+
+
+def test_threshold_study_parts_for_a_broadening_pulse(tmp_path):
+    """Half-sines whose width grows with distance, T(d) = T0 (1 + d / 10 mm): the
+    arrival at fraction f is t0 + d/c_P + T(d)/pi asin(f), a different phase of the
+    pulse at each probe, so the speed depends on f; each row of the study is the
+    least-squares line through those times, computed here."""
+    path = tmp_path / "run.h5"
+    write_run(path)
+    T0, t0 = 1e-6, 0.5e-6
+
+    def width(d):
+        return T0 * (1.0 + d / 0.01)
+    d = put_series(path, lambda n, d, t: half_sine(t, t0 + d / C_P, width(d), 150e6 / (d * 1e3)))
+    m, _ = analyse(path)
+    ws = m["wave_speed"]
+    names = ws["probes"]
+    dd = np.array([d[n] for n in names])
+    speeds = []
+    for r in ws["threshold_study"]:
+        te = t0 + dd / C_P + width(dd) / math.pi * math.asin(r["fraction"])
+        assert r["speed_m_s"] == pytest.approx(np.polyfit(te, dd, 1)[0], rel=1e-4)
+        speeds.append(r["speed_m_s"])
+    assert speeds == sorted(speeds, reverse=True)        # later phases lag more with distance
+    assert speeds[0] < C_P and speeds[-1] < 0.95 * C_P
 
 
 def test_arrivals_out_of_order_are_an_error(tmp_path):

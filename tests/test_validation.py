@@ -64,6 +64,10 @@ def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces"
            "explosive_reference": {"consistency_MPa": list(CONSISTENCY)}, "targets": rows}
     if lattice_bias is not None:
         doc["lattice_bias"] = lattice_bias
+    if case == "alpha":         # its wave speed against the arrival threshold
+        doc["wave_speed"] = {"probes": ["A", "B", "C"], "threshold_study": [
+            {"fraction": 0.02, "speed_m_s": 5933.4}, {"fraction": 0.1, "speed_m_s": 5616.2},
+            {"fraction": 0.5, "error": "first-arrival times do not increase"}]}
     if case == "alpha":         # a run stopped at step 200 on 2 ranks, restarted on 3
         doc["run"]["segments"] = [
             {"from_step": 0, "to_step": 200, "ranks": 2, "wall_s": 60.0,
@@ -154,6 +158,10 @@ def test_record(two_reports, capsys):
     assert prov["throughput"] == [f"{999 * 600 / 240 / 1e6:.2f} M bond-steps/s "
                                   f"({per_rank / 1e6:.2f} M per rank)", "not recorded"]
 
+    ts = table(md, "## Wave speed against the arrival threshold")
+    assert ts[0] == ["run", "probes", "2 %", "10 %", "50 %"]
+    assert ts[2:] == [["alpha", "A, B, C", "5933", "5616", "error"]]    # beta has none
+
     bias = table(md, "## Lattice bias")
     assert bias[0][:3] == ["run", "section", "ring (mm)"]
     assert bias[2] == ["alpha", "detonation_face", "10–25", "321", "0.41", "0.12", "0.05", "4"]
@@ -193,6 +201,7 @@ def test_without_lattice_bias_and_notes(two_reports, capsys):
     assert main(["validate", "--out", str(out), str(b)]) == 0
     md = (tmp / "v" / "validation.md").read_text()
     assert "## Lattice bias" not in md
+    assert "## Wave speed against the arrival threshold" not in md
     assert "No notes were given" in md
     assert len(table(md, "## Targets")) == 2 + len(TARGETS)
 
