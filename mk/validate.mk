@@ -17,3 +17,11 @@ validate: install
 	@$(PY) -m postprocess validate --check $(VALIDATE_RUNS)
 	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
 	    $(VALIDATE_RUNS) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES))
+
+# `make diagnoses`: the cheaper runs behind docs/validation_notes.md's diagnoses, each
+# changing one thing, and their tables under docs/diagnoses/ (a run file that exists
+# under runs/diag/ is reused; delete it to run it again).
+.PHONY: diagnoses
+diagnoses: install
+	$(PY) benchmarks/diagnoses/wave_speed.py --study --mpirun "$(MPIRUN)" \
+	    --out docs/diagnoses/wave_ring_elastic.md

@@ -19,10 +19,17 @@ so its first-arrival speed is c_P at every fraction; what the runs show beyond t
 is the discretisation.
 
     python benchmarks/diagnoses/wave_speed.py RUN.h5 [RUN.h5 ...]
+    python benchmarks/diagnoses/wave_speed.py --study [--out FILE.md]
+
+``--study`` runs the variants of ``VARIANTS`` whose run file is missing (under
+mpirun, ``--ranks``, into ``runs/diag/<name>``) and writes the table of all of them
+(``make diagnoses`` writes docs/validation/diagnoses/wave_ring_elastic.md).
 """
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -37,6 +44,18 @@ from postprocess import arrivals                   # noqa: E402
 from postprocess.model import split_scene_text     # noqa: E402
 
 PROBES = ("A", "B", "C", "D", "E", "F", "G")
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+# name -> (scene file, --set overrides): the horizon at fixed dx, dx at a fixed
+# horizon factor, and the larger ring for the peaks and n
+VARIANTS = {
+    "elastic_dx2.0": ("wave_ring_elastic.toml", ["parts.0.dx=2.0e-3"]),
+    "elastic_dx1.5": ("wave_ring_elastic.toml", ["parts.0.dx=1.5e-3"]),
+    "elastic_dx1.0": ("wave_ring_elastic.toml", []),
+    "elastic_m2": ("wave_ring_elastic.toml", ["parts.0.horizon_factor=2.0"]),
+    "elastic_m4": ("wave_ring_elastic.toml", ["parts.0.horizon_factor=4.0"]),
+    "elastic_r60": ("wave_ring_elastic_r60.toml", []),
+}
 
 
 def closed_form(t, r, a, load, rho, K, G, window=30.0):
@@ -99,24 +118,73 @@ def one(path):
     return rock.dx, names, d, measures(names, d, recs), measures(names, d, exact), c
 
 
+def run_missing(out_root: Path, mpirun: str, ranks: int) -> list[str]:
+    """Run every variant whose run file is missing; their run files, in order."""
+    files = []
+    for name, (scene, sets) in VARIANTS.items():
+        out = out_root / name
+        if not (out / "run.h5").is_file():
+            cmd = [*mpirun.split(), "-n", str(ranks), str(ROOT / ".venv" / "bin" / "mpipd"), "run",
+                   str(HERE / scene), "--out", str(out)]
+            for s in sets:
+                cmd += ["--set", s]
+            print(" ".join(cmd), flush=True)
+            with open(out_root / f"{name}.log", "w") as log:
+                subprocess.run(cmd, check=True, stdout=log, stderr=subprocess.STDOUT,
+                               env={**os.environ, "OMP_NUM_THREADS": "1"})
+        files.append(str(out / "run.h5"))
+    return files
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("runs", nargs="+")
+    ap.add_argument("runs", nargs="*")
+    ap.add_argument("--study", action="store_true", help="run the missing VARIANTS, table of all")
+    ap.add_argument("--runs-dir", default=str(ROOT / "runs" / "diag"))
+    ap.add_argument("--mpirun", default="mpirun")
+    ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--out", help="write the table (markdown) here as well")
     args = ap.parse_args(argv)
-    cols = [f"{f * 100:g} %" for f in arrivals.STUDY] + ["peak arrivals", "peak −σ_rr (MPa)", "n"]
-    print("Speeds (m/s) from the first arrivals at each fraction of the probe's peak, and "
-          "from the peak arrivals; the peaks and the exponent n of peak = C d^-n.")
-    print()
-    print("| run | rock dx (mm) | probes | 10 % arrivals (µs) | " + " | ".join(cols) + " |")
-    print("|---|---|---|---|" + "---|" * len(cols))
-    for p in args.runs:
-        dx, names, d, run, ex, c = one(p)
-        for label, m in ((p, run), (f"closed form (c_P = {c:.0f} m/s)", ex)):
-            print(f"| {label} | {dx * 1e3:g} | {', '.join(names)} | "
-                  + ", ".join(f"{v:.3f}" for v in m["t10"]) + " | "
-                  + " | ".join(f"{m[k]:.0f}" for k in (*arrivals.STUDY, "peak")) + " | "
-                  + ", ".join(f"{v:.1f}" for v in m["peaks"]) + f" | {m['n']:.2f} |")
+    if args.study:
+        Path(args.runs_dir).mkdir(parents=True, exist_ok=True)
+        args.runs = run_missing(Path(args.runs_dir), args.mpirun, args.ranks)
+    if not args.runs:
+        ap.error("give run files or --study")
+    lines = table(args.runs)
+    print("\n".join(lines))
+    if args.out:
+        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short=12", "HEAD"],
+                                capture_output=True, text=True).stdout.strip() or "unknown"
+        head = ["# Diagnosis: the first-arrival wave speed and the peaks of an elastic ring", "",
+                f"Written by `python benchmarks/diagnoses/wave_speed.py {' '.join(argv or sys.argv[1:])}` "
+                f"at commit {commit}, from the run files named in the first column (scenes "
+                "`benchmarks/diagnoses/wave_ring_elastic*.toml`, overrides in `VARIANTS`).  "
+                "Each run's row is followed by the closed form (plane strain, infinite medium) "
+                "for the same probe points and load.", ""]
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text("\n".join(head + lines) + "\n")
     return 0
+
+
+def table(runs) -> list[str]:
+    """Markdown rows: each run, then the closed form for its probe points and load."""
+    cols = [f"{f * 100:g} %" for f in arrivals.STUDY] + [
+        "peak arrivals", "peak −σ_rr (MPa)", "n", "10 % lead on the closed form (µs)"]
+    L = ["Speeds (m/s) from the first arrivals at each fraction of the probe's own peak "
+         "−σ_rr, and from the peak arrivals; the peaks, the exponent n of peak = C d^-n, and "
+         "how much earlier than the closed form each probe's 10 % arrival comes.", "",
+         "| run | rock dx (mm) | probes (d, mm) | 10 % arrivals (µs) | " + " | ".join(cols) + " |",
+         "|---|---|---|---|" + "---|" * len(cols)]
+    for p in runs:
+        dx, names, d, run, ex, c = one(p)
+        lead = ", ".join(f"{a - b:.3f}" for a, b in zip(ex["t10"], run["t10"]))
+        for label, m, extra in ((f"`{p}`", run, lead), (f"closed form (c_P = {c:.0f} m/s)", ex, "")):
+            L.append(f"| {label} | {dx * 1e3:g} | "
+                     + ", ".join(f"{n} {v * 1e3:.2f}" for n, v in zip(names, d)) + " | "
+                     + ", ".join(f"{v:.3f}" for v in m["t10"]) + " | "
+                     + " | ".join(f"{m[k]:.0f}" for k in (*arrivals.STUDY, "peak")) + " | "
+                     + ", ".join(f"{v:.1f}" for v in m["peaks"]) + f" | {m['n']:.2f} | {extra} |")
+    return L
 
 
 if __name__ == "__main__":
