@@ -94,6 +94,7 @@ def one(path):
     with h5py.File(path, "r") as f:
         head, sets = split_scene_text(f.attrs["scene"])
         scene = parse(head, str(path), sets)
+        commit = str(f.attrs.get("git_commit", "unknown"))[:12]
         x = f["geometry/x"][...]
         recs, names, r = {}, [], []
         for n in PROBES:
@@ -115,7 +116,7 @@ def one(path):
         y, c = closed_form(recs[n][0], rr, a, load, mat.density, mat.bulk_modulus,
                            mat.shear_modulus)
         exact[n] = (recs[n][0], y)
-    return rock.dx, names, d, measures(names, d, recs), measures(names, d, exact), c
+    return rock.dx, names, d, measures(names, d, recs), measures(names, d, exact), c, commit
 
 
 def run_missing(out_root: Path, mpirun: str, ranks: int) -> list[str]:
@@ -176,9 +177,13 @@ def table(runs) -> list[str]:
          "| run | rock dx (mm) | probes (d, mm) | 10 % arrivals (µs) | " + " | ".join(cols) + " |",
          "|---|---|---|---|" + "---|" * len(cols)]
     for p in runs:
-        dx, names, d, run, ex, c = one(p)
+        dx, names, d, run, ex, c, commit = one(p)
+        try:
+            shown = Path(p).resolve().relative_to(ROOT)
+        except ValueError:
+            shown = p
         lead = ", ".join(f"{a - b:.3f}" for a, b in zip(ex["t10"], run["t10"]))
-        for label, m, extra in ((f"`{p}`", run, lead), (f"closed form (c_P = {c:.0f} m/s)", ex, "")):
+        for label, m, extra in ((f"`{shown}` (at {commit})", run, lead), (f"closed form (c_P = {c:.0f} m/s)", ex, "")):
             L.append(f"| {label} | {dx * 1e3:g} | "
                      + ", ".join(f"{n} {v * 1e3:.2f}" for n, v in zip(names, d)) + " | "
                      + ", ".join(f"{v:.3f}" for v in m["t10"]) + " | "

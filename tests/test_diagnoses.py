@@ -1,0 +1,49 @@
+"""The closed form behind `make diagnoses` (benchmarks/diagnoses/wave_speed.py): the
+cylindrical cavity under a pressure history, checked against two limits computed
+here — causality (nothing before (r - a)/c_P) and the quasi-static Lamé field
+sigma_rr = -p a^2 / r^2 for a slow load."""
+import importlib.util
+import math
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+spec = importlib.util.spec_from_file_location(
+    "wave_speed", ROOT / "benchmarks" / "diagnoses" / "wave_speed.py")
+ws = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(ws)
+
+RHO, K, G = 2660.0, 21.9e9, 25.7e9
+C_P = math.sqrt((K + 4 * G / 3) / RHO)
+A = 3.2e-3
+
+
+class Pulse:
+    def __init__(self, p0, alpha, beta):
+        self.p0, self.alpha, self.beta = p0, alpha, beta
+
+    def value(self, t):
+        return self.p0 * (math.exp(-self.alpha * t) - math.exp(-self.beta * t))
+
+
+def test_nothing_arrives_before_the_p_wave():
+    t = np.arange(600) * 2e-8
+    load = Pulse(3e8, 2e5, 2e6)
+    for r in (2 * A, 4 * A, 8 * A):
+        y, c = ws.closed_form(t, r, A, load, RHO, K, G)
+        assert c == pytest.approx(C_P, rel=1e-12)
+        before = t < (r - A) / C_P - 0.1e-6
+        assert np.abs(y[before]).max() < 2e-3 * y.max()
+        assert y.max() > 0
+
+
+def test_a_slow_load_gives_the_lame_field():
+    """p rises over ~1 ms, 1000 transit times a/c_P: sigma_rr(r) -> -p(t) a^2/r^2."""
+    t = np.arange(4000) * 5e-7
+    load = Pulse(1e8, 2e2, 2e3)
+    for r in (1.5 * A, 3 * A):
+        y, _ = ws.closed_form(t, r, A, load, RHO, K, G)
+        p = np.array([load.value(x) for x in t])
+        k = slice(1000, 4000)
+        assert y[k] == pytest.approx(p[k] * (A / r) ** 2, rel=2e-2, abs=1e-3 * p.max())
