@@ -8,7 +8,7 @@
 #   make validate VALIDATE_RUNS="runs/demo/run.h5"      # another set of runs
 .PHONY: validate
 
-VALIDATE_RUNS ?= runs/blast_paper_dx1.2/run.h5 runs/demo/run.h5
+VALIDATE_RUNS ?= runs/blast_paper_dx1.2/run.h5 runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
 VALIDATE_RANKS ?= 2
