@@ -2,7 +2,8 @@
 
 A checkpoint holds everything the next step needs that cannot be recomputed
 from it: u, v, a, the unrotated stress, R, V, strain energy, the fallback
-flags, failure modes, every material history array, the broken bonds (as
+flags, failure modes, every material history array (``points/state<material
+id>/<name>``, on every rank, zeros where a rank has no point of that material), the broken bonds (as
 (gid_i, gid_j) pairs), the gas's volume, pressure and energy, the loads' work,
 the step and the time, and the scene text.  Shape tensors, F, damage phi, the damped set and the force data are
 rebuilt from it deterministically.
@@ -54,11 +55,16 @@ def _per_point(sim) -> dict:
     for key, arr in sim.peaks.arrays.items():
         if len(arr):
             out[key] = arr
-    for gi, g in enumerate(c.groups):
-        for key, arr in g.state.items():
+    # material history by material id, the same names on every rank (the datasets are
+    # created collectively): a material with no points here writes zeros
+    here = {g.mid: g for g in c.groups}
+    for mid, mat in enumerate(c.materials):
+        g = here.get(mid)
+        for key, arr in (g.state if g is not None else mat.new_state(0)).items():
             full = np.zeros((n,) + arr.shape[1:], arr.dtype)
-            full[g.idx] = arr
-            out[f"state{gi}/{key}"] = full
+            if g is not None:
+                full[g.idx] = arr
+            out[f"state{mid}/{key}"] = full
     if sim.gas is not None:                       # volume, pressure, energy of the gas
         gas = sim.gas
         out["gas_V"] = gas.gd[:n, 6]
@@ -283,9 +289,9 @@ def restore(sim, path) -> None:
     sim.u[:n], sim.v[:n], sim.a[:] = data["u"], data["v"], data["a"]
     c.sigma[:], c.R[:], c.V[:], c.W[:] = data["sigma"], data["R"], data["V"], data["W"]
     sim.mode[:n] = data["mode"]
-    for gi_, g in enumerate(c.groups):
+    for g in c.groups:
         for key, arr in g.state.items():
-            arr[:] = data[f"state{gi_}/{key}"][g.idx]
+            arr[:] = data[f"state{g.mid}/{key}"][g.idx]
     # broken bonds by gid pair
     fam, gid = sim.families, sim.points.gid
     if len(mine):

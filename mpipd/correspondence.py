@@ -33,8 +33,9 @@ RCOND = 1e-8
 class MaterialGroup:
     """The owned points of one material and that material's history arrays."""
 
-    def __init__(self, material, idx: np.ndarray):
+    def __init__(self, material, idx: np.ndarray, mid: int):
         self.material = material
+        self.mid = mid                          # the material's id (points.material)
         self.idx = idx.astype(np.int64)
         self.state = material.new_state(len(idx))
 
@@ -53,11 +54,12 @@ class Correspondence:
         self.points = points
         self.families = families
         mats = [materials[m] for m in material_names]
-        self.groups = []
+        self.materials = mats                   # by material id, on every rank
+        self.groups = []                        # the materials with points on this rank
         for mid, mat in enumerate(mats):
             idx = np.nonzero(points.material[:n] == mid)[0]
             if len(idx):
-                self.groups.append(MaterialGroup(mat, idx))
+                self.groups.append(MaterialGroup(mat, idx, mid))
         eye = np.broadcast_to(np.eye(3), (n, 3, 3))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
