@@ -23,7 +23,7 @@ is the discretisation.
 
 ``--study`` runs the variants of ``VARIANTS`` whose run file is missing (under
 mpirun, ``--ranks``, into ``runs/diag/<name>``) and writes the table of all of them
-(``make diagnoses`` writes docs/validation/diagnoses/wave_ring_elastic.md).
+(``make diagnoses`` writes docs/diagnoses/wave_ring_elastic.md).
 """
 from __future__ import annotations
 
@@ -39,6 +39,7 @@ from scipy.special import h2vp, hankel2
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
+from mpipd.loads import BoreholePressure           # noqa: E402
 from mpipd.scene import parse                      # noqa: E402
 from postprocess import arrivals                   # noqa: E402
 from postprocess.model import split_scene_text     # noqa: E402
@@ -82,9 +83,10 @@ def measures(names, d, recs):
     for f in arrivals.STUDY:
         ta = [arrivals.first_arrival(*recs[n], f).get("t_s", np.nan) for n in names]
         out[f] = arrivals.speed(names, d, ta).get("speed_m_s", np.nan)
+        if f == arrivals.FRACTION:
+            out["t10"] = [x * 1e6 for x in ta]
     tp = [recs[n][0][int(np.argmax(recs[n][1]))] for n in names]
     out["peak"] = float(np.polyfit(tp, d, 1)[0])
-    out["t10"] = [arrivals.first_arrival(*recs[n], 0.1).get("t_s", np.nan) * 1e6 for n in names]
     out["peaks"] = [float(np.max(recs[n][1])) / 1e6 for n in names]
     out["n"] = -float(np.polyfit(np.log(d), np.log(out["peaks"]), 1)[0])
     return out
@@ -106,7 +108,7 @@ def one(path):
             recs[n] = (t[keep], -s[keep])
             names.append(n)
             r.append(float(np.hypot(*x[int(g.attrs["gid"])][:2])))
-    load = next(ld for ld in scene.loads if type(ld).__name__ == "BoreholePressure")
+    load = next(ld for ld in scene.loads if isinstance(ld, BoreholePressure))
     rock = scene.parts[0]
     mat = scene.materials[rock.material]
     a = load.radius
@@ -125,7 +127,7 @@ def run_missing(out_root: Path, mpirun: str, ranks: int) -> list[str]:
     for name, (scene, sets) in VARIANTS.items():
         out = out_root / name
         if not (out / "run.h5").is_file():
-            cmd = [*mpirun.split(), "-n", str(ranks), str(ROOT / ".venv" / "bin" / "mpipd"), "run",
+            cmd = [*mpirun.split(), "-n", str(ranks), str(Path(sys.executable).parent / "mpipd"), "run",
                    str(HERE / scene), "--out", str(out)]
             for s in sets:
                 cmd += ["--set", s]
