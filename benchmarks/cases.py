@@ -7,7 +7,7 @@ whether each got there and how physical its end state is.
 Each run goes to ``OUT/<scene>/<case>/`` (``base`` is the scene itself) with
 ``mpipd run SCENE[:CASE] --overwrite``; a case whose run.h5 already ends at its last
 step is not run again (delete the folder to redo it).  From each run file
-(mpipd.ledger, the run's own /energy record and every-step peak fields) the table
+(mpipd.model.ledger, the run's own /energy record and every-step peak fields) the table
 gives: exit status, the last step against the scene's, the loop's wall time and
 throughput (run.h5 attr ``segments``), points, failed points by mode, the closure
 error of the energy ledger, impossible energies, and the largest every-step speed
@@ -30,8 +30,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from mpipd import scene as sc  # noqa: E402
-from mpipd.ledger import Energies, impossible  # noqa: E402
+from mpipd.input import scene as sc  # noqa: E402
+from mpipd.model.ledger import Energies, impossible  # noqa: E402
 
 
 def finished(h5: Path) -> bool:

@@ -55,14 +55,14 @@ def granite():
 
 
 def build_scene(d):
-    from mpipd.schema import build
-    from mpipd.scene import Scene
+    from mpipd.input.schema import build
+    from mpipd.input.scene import Scene
     return build(Scene, d)
 
 
 def stable_step(scene) -> float:
     """The step `mpipd run` accepts at most (the Silling-Askari / CFL estimate)."""
-    from mpipd.report import stable_dt
+    from mpipd.check import stable_dt
     return min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
 
 
@@ -409,7 +409,7 @@ class JH2Point:
 
     def run(self, team, n_steps, steps=None):
         from mpipd.materials.jh2 import JH2
-        from mpipd.schema import build
+        from mpipd.input.schema import build
         prm = dict(JH2_TABLE1, D1=self.D1)
         mat = build(JH2, {"D1": self.D1})
         dt = self.EPS_END / self.RATE / n_steps
@@ -614,7 +614,7 @@ def main(argv=None):
             ap.error(f"unknown problem {key!r}")
     from mpi4py import MPI
 
-    from mpipd.parallel import Team
+    from mpipd.parallel.team import Team
     team = Team(MPI.COMM_WORLD)
     for key in keys:
         prob = PROBLEMS[key]()

@@ -10,7 +10,7 @@
 SCENE is a TOML file or the name of a built-in scene.  Bad input (scene
 errors, an existing output file, a decomposition that cannot work) prints one
 line ``mpipd: error: <what>`` on rank 0 and exits with status 2 on every rank,
-before anything is written.  A run writes only its own files (mpipd.rundir:
+before anything is written.  A run writes only its own files (mpipd.output.rundir:
 run ids, the restart and --overwrite rules).  A file of the run that cannot be
 written (disk full, read-only) prints one line and exits with status 4; a
 blow-up exits with 3; a clean stop with a checkpoint (--stop-after, SIGTERM or
@@ -23,6 +23,8 @@ import argparse
 import os
 import sys
 from pathlib import Path
+
+from .kernels.layout import MODE_NAMES, N_MODES
 
 EXIT_BAD_INPUT = 2
 EXIT_UNSTABLE = 3
@@ -76,8 +78,8 @@ def _error(msg: str) -> int:
 
 
 def _guard_serial(fn, args) -> int:
-    from .decomp import DecompositionError
-    from .schema import SceneError
+    from .parallel.decomp import DecompositionError
+    from .input.schema import SceneError
     try:
         return fn(args)
     except (SceneError, DecompositionError, UsageError) as e:
@@ -87,7 +89,7 @@ def _guard_serial(fn, args) -> int:
 # ----------------------------------------------------------------------------- scenes
 
 def cmd_scenes() -> int:
-    from . import scene as sc
+    from .input import scene as sc
     for name, path in sorted(sc.builtin_scenes().items()):
         try:
             desc = sc.load(str(path))[0].scene.description
@@ -99,7 +101,7 @@ def cmd_scenes() -> int:
 
 def cmd_cases(args) -> int:
     """One line a case: ``SCENE:CASE``, its study and what it changes."""
-    from . import scene as sc
+    from .input import scene as sc
     if args.scene not in sc.builtin_scenes():
         raise UsageError(f"no built-in scene {args.scene!r}")
     for name, case in sc.cases(args.scene).items():
@@ -110,8 +112,8 @@ def cmd_cases(args) -> int:
 # ----------------------------------------------------------------------------- check
 
 def cmd_check(args) -> int:
-    from . import scene as sc
-    from .report import check_report
+    from .input import scene as sc
+    from .check import check_report
     if args.ranks < 1:
         raise UsageError(f"--ranks must be >= 1 (got {args.ranks})")
     scene, _ = sc.load(args.scene, args.set)
@@ -122,10 +124,10 @@ def cmd_check(args) -> int:
 # ----------------------------------------------------------------------------- run
 
 def cmd_run(args) -> int:
-    from .checkpoint import SignalFlag
+    from .output.checkpoint import SignalFlag
     signals = SignalFlag()         # first: a batch system's early warning must not kill the run
     os.environ.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    from .parallel import abort_on_error, world
+    from .parallel.team import abort_on_error, world
     team = world()
     return abort_on_error(team, _run, args, team, signals)
 
@@ -137,13 +139,13 @@ def _bad_input(team, exc) -> int:
 
 
 def _run(args, team, signals=None) -> int:
-    from . import checkpoint as ck
-    from . import rundir
-    from . import scene as sc
-    from .decomp import DecompositionError
-    from .geometry import check_parts
-    from .report import stable_dt
-    from .schema import SceneError
+    from .output import checkpoint as ck
+    from .output import rundir
+    from .input import scene as sc
+    from .parallel.decomp import DecompositionError
+    from .input.geometry import check_parts
+    from .check import stable_dt
+    from .input.schema import SceneError
     from .solver import Simulation
 
     bad_input = (SceneError, DecompositionError, UsageError, ck.CheckpointError,
@@ -213,7 +215,7 @@ def _run(args, team, signals=None) -> int:
 
 def _shown(text: str, overrides) -> str:
     """The scene text as a run file stores it: the TOML and its --set overrides."""
-    from .rundir import OVERRIDES_MARK
+    from .output.rundir import OVERRIDES_MARK
     return text + (OVERRIDES_MARK + "".join(f"# {o}\n" for o in overrides) if overrides else "")
 
 
@@ -232,8 +234,8 @@ def _on_root(team, fn, *args):
 
 def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
             dt_stable, run_id, resume) -> int:
-    from . import checkpoint as ck
-    from .output import Writer
+    from .output import checkpoint as ck
+    from .output.writer import Writer
     from .solver import Progress, Unstable
     log = RunLog(out / "run.log", team)
     what = f"restart at step {sim.step_count}, " if args.restart else ""
@@ -287,9 +289,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     log(f"mpipd: done in {wall:.2f} s: {rate / 1e6:.2f} M bond-steps/s, "
         f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}")
     if sim.failure is not None:
-        log(f"mpipd: failed points: {failed[1]} JH2 plastic, {failed[2]} JH2 tensile, "
-            f"{failed[3]} tension model; {broken} bonds broken")
-    from .ledger import impossible
+        log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))
+            + f"; {broken} bonds broken")
+    from .model.ledger import impossible
     e = sim.energies()
     log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "
         f"held {e.held:.6g} J + dissipated {e.dissipated:.6g} J; balance {e.balance:+.2e}")

@@ -1,7 +1,7 @@
 """Assemble the step pipeline a scene needs and run the time loop.
 
 :class:`Simulation` is built on every rank from the same validated scene and
-the run's :class:`mpipd.parallel.Team`:
+the run's :class:`mpipd.parallel.team.Team`:
 
 1. layer table -> slab decomposition -> this rank's owned + ghost points only
    (the explosive gas and its ``interacts_with`` solids: all of them, as ghosts);
@@ -26,18 +26,19 @@ import time as _time
 
 import numpy as np
 
-from .correspondence import Correspondence
-from .decomp import decompose, halo_width, local_points, replicated_parts
-from .failure import Failure
-from .families import build_families
-from .geometry import LayerTable
-from .gas import Gas
-from .halo import Halo
-from .interface import InterfaceCorrection, needed as interface_needed
+from .model.correspondence import Correspondence
+from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
+from .model.failure import Failure
+from .model.families import build_families
+from .input.geometry import LayerTable
+from .model.gas import Gas
+from .parallel.halo import Halo
+from .model.interface import InterfaceCorrection, needed as interface_needed
 from .kernels import integrate, runaway
-from .ledger import Energies, Ledger
-from .peaks import Peaks
-from .probes import Probes
+from .kernels.layout import CORRESPONDENCE, N_MODES, SPRING_F
+from .model.ledger import Energies, Ledger
+from .output.peaks import Peaks
+from .output.probes import Probes
 
 
 class Unstable(RuntimeError):
@@ -137,7 +138,7 @@ class Simulation:
     def compute_forces(self):
         """Force data of owned points -> halo -> gathered internal force density."""
         toggled = self.corr.force_data()
-        if len(toggled):                            # points that switched to/from code 2
+        if len(toggled):                            # points that switched to/from SPRING_F
             self._book_toggles(toggled)
         if self.gas is not None:
             self.halo.exchange(self.corr.fd, self.gas.gd)
@@ -167,7 +168,7 @@ class Simulation:
         jump; the ledger books before - after."""
         c = self.corr
         now = c.spring[rows].copy()
-        c.spring[rows] = np.where(now == 2, 0, 2).astype(np.uint8)
+        c.spring[rows] = np.where(now == SPRING_F, CORRESPONDENCE, SPRING_F).astype(np.uint8)
         before = c.potentials(rows, self.u)
         c.spring[rows] = now
         self.ledger.book_jump(before, c.potentials(rows, self.u))
@@ -218,7 +219,7 @@ class Simulation:
 
     # ------------------------------------------------------------------ diagnostics
     def energies(self) -> Energies:
-        """The energy ledger now (global; mpipd.ledger)."""
+        """The energy ledger now (global; mpipd.model.ledger)."""
         e = self.ledger.read(self)
         if not np.isfinite(e.held + e.dissipated):
             self.check_finite()
@@ -264,7 +265,7 @@ class Simulation:
     def failure_counts(self) -> np.ndarray:
         """Failed owned points per mode over all ranks (index = mode, 0 = intact)."""
         if self.failure is None:
-            return np.array([self.n_global, 0, 0, 0])
+            return np.array([self.n_global] + [0] * (N_MODES - 1))
         return self.team.sum(self.failure.counts())
 
     def spring_points(self) -> int:

@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from mpipd.kernels.layout import MODE_LABELS
+
 from .plotting import borehole, pyplot, save
 from .sections import NAMED, lattice_image
 
 MODE_COLORS = ("#d9d9d9", "#d62728", "#1f77b4", "#2ca02c")
-MODE_LABELS = ("intact", "JH2 plastic (D ≥ 1)", "JH2 tensile (p < −T)", "tension model")
 
 
 def _damage_panel(ax, sec, key, model, title):

@@ -1,6 +1,6 @@
 """The run's energy ledger, ``/energy/<term>`` (J, one value per frame).
 
-Terms (mpipd.ledger, which defines them): held = kinetic + integrator + elastic +
+Terms (mpipd.model.ledger, which defines them): held = kinetic + integrator + elastic +
 hourglass + spring + contact + gas; dissipated = plastic + removed + contact_onset +
 viscous + damping + gas_damping + interface;
 the books close as initial + external = held + dissipated, and ``balance`` is the
@@ -8,7 +8,7 @@ relative closure error (initial + external - held - dissipated) / scale.
 
 The report reads whichever terms the file has (older files: kinetic, strain, gas,
 total, external, hourglass), gives the final value of each and the largest
-|balance|.  A term that must be non-negative (``mpipd.ledger.NON_NEGATIVE``) going
+|balance|.  A term that must be non-negative (``mpipd.model.ledger.NON_NEGATIVE``) going
 below -BALANCE_TOL (1e-3) of the ledger's scale (the largest magnitude of any J
 term at any frame; the solver's own check uses the same tolerance) is an error: it is reported as such and its values are not shown as numbers.
 """
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpipd.ledger import BALANCE_TOL as TOL, DISSIPATED, HELD, NON_NEGATIVE
+from mpipd.model.ledger import BALANCE_TOL as TOL, DISSIPATED, HELD, NON_NEGATIVE
 
 BOOKS = ("initial", "external")
 TERMS = HELD + DISSIPATED + BOOKS

@@ -4,18 +4,18 @@ The borehole axis ``center`` (x, y), the borehole-wall radius ``r_wall`` (the
 rock part's inner radius: the copper tube sits inside the borehole), the outer
 radius ``r_out``, the rock's thickness ``z0..z1`` and lattice spacing ``dx``,
 the rock's horizon, the densities and the JH2 parameters are read from the scene text stored in the
-run file (``attrs['scene']``, parsed with :func:`mpipd.scene.parse` together with
+run file (``attrs['scene']``, parsed with :func:`mpipd.input.scene.parse` together with
 the ``--set`` overrides recorded after ``# overrides (--set)``).  If the scene
 cannot be parsed, or the rock is not an annulus, they fall back to the geometry:
 
     r_wall = min r - dx/2,   r_out = max r + dx/2,   dx = V^(1/3)
 
-over the rock points (exact for the lattice of ``mpipd.geometry``: cell centres
+over the rock points (exact for the lattice of ``mpipd.input.geometry``: cell centres
 at half-integer multiples of dx).  Which fallback was used is in ``notes``.
 
 The rock is the part named ``rock``; else the part of a ``jh2`` material; else
 the largest part.  A rock split into zones (``<rock>.band``, ``<rock>.0``, ...;
-:meth:`mpipd.scene.Part.zones`) is all of them: ``rock_ids`` lists every zone,
+:meth:`mpipd.input.scene.Part.zones`) is all of them: ``rock_ids`` lists every zone,
 R_b is the innermost zone's inner radius, R_o the outermost zone's radius and
 ``wall_dx`` the innermost zone's dx (the wall layer is r < R_b + wall_dx);
 ``rock`` stays the zone of the sections and cracks (the one named ``rock``, or the
@@ -104,7 +104,7 @@ def _parse_scene(run, notes):
         return None, []
     body, sets = split_scene_text(str(text))
     try:
-        from mpipd.scene import parse
+        from mpipd.input.scene import parse
         return parse(body, "stored scene", sets), sets
     except Exception as e:                                  # noqa: BLE001 (SceneError, ImportError)
         notes.append(f"the stored scene does not parse ({' '.join(str(e).split())}): "

@@ -1,4 +1,4 @@
-"""Metrics from the probes, recorded every step (``/probes/<name>``, mpipd.probes).
+"""Metrics from the probes, recorded every step (``/probes/<name>``, mpipd.output.probes).
 
 Probes A–G sit at 6.8, 10.8, 22, 29.2, 39.6, 50 and 59.6 mm from the borehole
 wall, P1–P3 at 0.8, 1.6 and 4.8 mm (paper Figs. 6, 15), ``wall`` on the rock's

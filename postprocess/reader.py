@@ -2,7 +2,7 @@
 
 Every rank of ``comm`` opens the file with h5py's ``mpio`` driver and reads only
 its own contiguous gid range ``lo:hi`` of any per-point dataset.  Global ids run
-over z levels (``mpipd.geometry``: gids follow (z, material, part, y, x)), and the
+over z levels (``mpipd.input.geometry``: gids follow (z, material, part, y, x)), and the
 reading slices are cut on **whole z levels**: a cross-section is then never
 split between ranks, and a sum is formed per z level on the rank that owns the
 level and the per-level partial sums are added in global level order

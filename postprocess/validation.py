@@ -74,7 +74,7 @@ def how_to_make(run_file: Path) -> str:
     folder = run_file.parent
     if run_file.name == "run.h5" and folder.name == "demo" and folder.parent.name == "runs":
         return "make demo"
-    from mpipd.scene import builtin_scenes, cases
+    from mpipd.input.scene import builtin_scenes, cases
     name, run = folder.name, f"mpirun -n {RANKS_HINT} mpipd run"
     scenes = builtin_scenes()
     if run_file.name == "run.h5":

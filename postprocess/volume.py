@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-MODES = {0: "intact", 1: "JH2 plastic (D >= 1)", 2: "JH2 tensile (p < -T)",
-         3: "tension model (Eq. 38)"}
+from mpipd.kernels.layout import MODE_LABELS, N_MODES
+
 NEGATIVE_TOL = 1e-9          # relative: a rock energy below -tol * max |E| is an error
 
 
@@ -132,11 +132,12 @@ def _failure_modes(run, rock) -> dict:
     nf = run.frames
     if run.has_field("failure_mode"):
         m = run.field("failure_mode", nf - 1)[rock].astype(int)
-        cnt = run.sum_array(np.bincount(np.clip(m, 0, 3), minlength=4).astype(np.int64))
-        return {MODES[i]: int(cnt[i]) for i in range(4)}
+        cnt = run.sum_array(np.bincount(np.clip(m, 0, N_MODES - 1), minlength=N_MODES)
+                            .astype(np.int64))
+        return {MODE_LABELS[i]: int(cnt[i]) for i in range(N_MODES)}
     if "failed_points_by_mode" in run.f.attrs:
         cnt = run.f.attrs["failed_points_by_mode"]
-        out = {MODES[i]: int(cnt[i]) for i in range(4)}
+        out = {MODE_LABELS[i]: int(cnt[i]) for i in range(N_MODES)}
         out["note"] = "whole model, from the file's failed_points_by_mode"
         return out
     return {"not_available": "no failure_mode field or attribute"}

@@ -41,8 +41,8 @@ def scene_dict(shape, dx=1e-3, dt=5e-8, steps=10, hourglass=0.01, initial=(), bo
 
 
 def make_scene(d):
-    from mpipd.schema import build
-    from mpipd.scene import Scene
+    from mpipd.input.schema import build
+    from mpipd.input.scene import Scene
     return build(Scene, d)
 
 
@@ -50,7 +50,7 @@ def make_scene(d):
 def team():
     from mpi4py import MPI
 
-    from mpipd.parallel import Team
+    from mpipd.parallel.team import Team
     return Team(MPI.COMM_SELF)
 
 

@@ -2,7 +2,7 @@
 Without the abort the job would hang; with it, mpirun exits non-zero at once."""
 from mpi4py import MPI
 
-from mpipd.parallel import Team, abort_on_error
+from mpipd.parallel.team import Team, abort_on_error
 
 team = Team(MPI.COMM_WORLD)
 

@@ -8,7 +8,7 @@ from mpi4py import MPI
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 from conftest import make_scene, scene_dict  # noqa: E402
 
-from mpipd.parallel import Team  # noqa: E402
+from mpipd.parallel.team import Team  # noqa: E402
 from mpipd.solver import Simulation  # noqa: E402
 
 dx = float(sys.argv[1])

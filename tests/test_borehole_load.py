@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from conftest import make_scene, scene_dict, run_cli
 
-from mpipd.loads import BoreholePressure
-from mpipd.schema import SceneError, build
+from mpipd.input.loads import BoreholePressure
+from mpipd.input.schema import SceneError, build
 from mpipd.solver import Simulation
 
 R, H, P = 0.020, 0.005, 1e8     # H: the mid-plane sits two lattice layers from the free faces

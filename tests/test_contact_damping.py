@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd import scene as sc
+from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 NEVER = {"sigma_st": -1e15}        # a tension model that never triggers: failure machinery on

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd.decomp import DecompositionError, decompose, halo_width, local_points
-from mpipd.families import build_families
-from mpipd.geometry import LayerTable, fill_layers
+from mpipd.parallel.decomp import DecompositionError, decompose, halo_width, local_points
+from mpipd.model.families import build_families
+from mpipd.input.geometry import LayerTable, fill_layers
 
 
 def two_part_scene():
@@ -94,8 +94,8 @@ def test_too_many_ranks_refused():
 def test_gas_and_the_solids_it_acts_on_are_on_every_rank():
     """detonation_tube: the charge and the copper it acts on (interacts_with) are held
     whole on every rank; the rock, which the gas does not touch, only within the halo."""
-    from mpipd import scene as sc
-    from mpipd.decomp import replicated_parts
+    from mpipd.input import scene as sc
+    from mpipd.parallel.decomp import replicated_parts
     scene, _ = sc.load("detonation_tube")
     names = [q.name for q in scene.parts]
     assert [names[k] for k in replicated_parts(scene)] == ["charge", "tube"]

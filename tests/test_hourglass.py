@@ -10,7 +10,7 @@
 import numpy as np
 from conftest import make_scene, scene_dict
 
-from mpipd import scene as sc
+from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 BOX = {"kind": "box", "lo": [0, 0, 0], "hi": [0.014, 0.014, 0.014]}

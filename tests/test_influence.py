@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd import scene as sc
-from mpipd.decomp import decompose, halo_width, local_points
-from mpipd.geometry import LayerTable, balls_inside
-from mpipd.schema import SceneError
+from mpipd.input import scene as sc
+from mpipd.parallel.decomp import decompose, halo_width, local_points
+from mpipd.input.geometry import LayerTable, balls_inside
+from mpipd.input.schema import SceneError
 from mpipd.solver import Simulation
 
 OMEGA = {

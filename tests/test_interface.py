@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd.geometry import balls_inside
+from mpipd.input.geometry import balls_inside
 from mpipd.solver import Simulation
 
 SIGMA = np.array([3e6, -1e6, 2e6, 5e5, -7e5, 4e5])
@@ -298,7 +298,7 @@ def test_inner_band_makes_the_tube_interface_seamless(team):
 
 
 def test_band_needs_an_annulus_and_fits_in_it():
-    from mpipd.schema import SceneError
+    from mpipd.input.schema import SceneError
     d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [0.006, 0.006, 0.006]})
     d["parts"][0]["band"] = {"dx": 3e-4, "width": 1e-3}
     with pytest.raises(SceneError, match="band"):

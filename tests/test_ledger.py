@@ -1,4 +1,4 @@
-"""The energy ledger closes (mpipd.ledger, issue 13).
+"""The energy ledger closes (mpipd.model.ledger, issue 13).
 
 balance = (initial + external - held - dissipated) / scale is the time
 discretisation error; each case states the bound it is held to (measured
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from mpipd import scene as sc
-from mpipd.ledger import DISSIPATED, HELD, impossible
+from mpipd.input import scene as sc
+from mpipd.model.ledger import DISSIPATED, HELD, impossible
 from mpipd.solver import Simulation
 
 sys.path.insert(0, str(ROOT / "tests"))
@@ -40,7 +40,7 @@ def run(scene, every=10):
 def _team():
     from mpi4py import MPI
 
-    from mpipd.parallel import Team
+    from mpipd.parallel.team import Team
     return Team(MPI.COMM_SELF)
 
 

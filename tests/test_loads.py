@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 from conftest import make_scene, run_cli, scene_dict
 
-from mpipd import scene as sc
-from mpipd.schema import SceneError
+from mpipd.input import scene as sc
+from mpipd.input.schema import SceneError
 from mpipd.solver import Simulation
 
 

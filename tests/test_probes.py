@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd import scene as sc
-from mpipd.probes import part_matches
-from mpipd.schema import SceneError
+from mpipd.input import scene as sc
+from mpipd.output.probes import part_matches
+from mpipd.input.schema import SceneError
 from mpipd.solver import Simulation
 
 L = 0.0048

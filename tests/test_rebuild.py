@@ -14,7 +14,7 @@ import pytest
 from conftest import make_scene, scene_dict
 
 from mpipd.materials.jh2 import JH2, jh2_pressure
-from mpipd.materials.tension import MODE_TENSION
+from mpipd.kernels.layout import MODE_TENSION
 from mpipd.solver import Simulation
 
 L, DX = 0.011, 1e-3

@@ -46,8 +46,8 @@ PROBES = {"A": 6.8, "B": 10.8, "C": 22.0, "D": 26.0, "P1": 0.8, "P2": 1.6, "P3":
 
 
 def lattice():
-    """Points of the scene in gid order (z, material, part, y, x), like mpipd.geometry."""
-    from mpipd.geometry import Annulus, Cylinder
+    """Points of the scene in gid order (z, material, part, y, x), like mpipd.input.geometry."""
+    from mpipd.input.geometry import Annulus, Cylinder
     cyl = Cylinder(center=(0.0, 0.0), radius=0.002, z=(0.0, NZ * DX))
     ann = Annulus(center=(0.0, 0.0), radius=R_OUT, z=(0.0, NZ * DX), inner_radius=R_WALL)
     xs, part = [], []
@@ -710,7 +710,7 @@ FIGURES = ("fig07_explosive_pressure", "fig07_pressure_plane", "fig09_fracture_f
 
 
 def demo_scene():
-    from mpipd.scene import builtin_scenes
+    from mpipd.input.scene import builtin_scenes
     return "blast_demo" if "blast_demo" in builtin_scenes() else "blast_slice"
 
 

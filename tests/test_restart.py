@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import run_cli
 
-from mpipd import checkpoint as ck
-from mpipd import scene as sc
+from mpipd.output.writer import checkpoint as ck
+from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 ARGS = ["--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=1.2e-5",

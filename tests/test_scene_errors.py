@@ -2,7 +2,7 @@
 import pytest
 from conftest import run_cli
 
-from mpipd import scene as sc
+from mpipd.input import scene as sc
 
 CASES = [
     (["--set", "parts.0.radus=1"], "parts[0].radus", "unknown key"),

@@ -16,7 +16,7 @@ from conftest import make_scene, run_cli
 from mpipd.materials.jh2 import JH2
 from mpipd.materials.jwl import JWL
 from mpipd.materials.tension import dynamic_strength
-from mpipd.report import check_report, critical_dt
+from mpipd.check import check_report, critical_dt
 from mpipd.solver import Simulation, Unstable
 
 
@@ -444,7 +444,7 @@ def test_fully_crushed_zone_is_stable(team):
     """granite_ring (coarse) with its wall thrown out at 300 m/s: a fully crushed
     (phi = 1) zone at the wall, cracks beyond; stable, damage only grows, and the
     energy only falls (damping, failures)."""
-    from mpipd import scene as sc
+    from mpipd.input import scene as sc
     scene, _ = sc.load("granite_ring", ["parts.0.dx=0.0015", "initial.0.speed=300",
                                         "time.t_end=8e-6"])
     sim = Simulation(scene, team)
@@ -544,8 +544,8 @@ def test_jh2_block_at_extreme_strain_rates(team, rate, kind):
 
 @pytest.fixture(scope="module")
 def blast_08(team):
-    from mpipd import scene as sc
-    from mpipd.ledger import impossible
+    from mpipd.input import scene as sc
+    from mpipd.model.ledger import impossible
     # the rock cut to r = 15 mm: probe C (25.2 mm) moves inside it
     scene, _ = sc.load("blast_demo", ["parts.2.dx=8e-4", "parts.2.shape.radius=0.015",
                                       "probes.3.position=[0.0145, 0.0, 0.003]",
@@ -600,7 +600,7 @@ PAPER_REDUCED = ["blast_paper:dx1.2", "--set", "parts.2.shape.radius=0.040",
 def test_paper_geometry_at_dx_1_2_runs_through_the_copper_blow_up(tmp_path):
     import h5py
 
-    from mpipd.ledger import Energies, impossible
+    from mpipd.model.ledger import Energies, impossible
     out = tmp_path / "paper"
     res = run_cli(["run", *PAPER_REDUCED, "--out", str(out), "--quiet"], ranks=2,
                   timeout=3600)

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from mpipd import scene as sc
+from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 RHO, K, G = 2660.0, 21.9e9, 25.7e9

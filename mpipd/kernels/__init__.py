@@ -10,6 +10,6 @@ only arrays and scalars.  One concern per module:
 ``rotation``   Flanagan–Taylor rotation / left-stretch update, unrotated d
 ``integrate``  velocity-Verlet kicks and drifts, energies
 
-Python objects in :mod:`mpipd.correspondence` and :mod:`mpipd.solver` gather the
+Python objects in :mod:`mpipd.model.correspondence` and :mod:`mpipd.solver` gather the
 arrays and call these; nothing here knows about MPI or scenes.
 """

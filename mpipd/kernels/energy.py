@@ -1,4 +1,4 @@
-"""Kernels of the energy ledger (mpipd.ledger, DESIGN §8b).
+"""Kernels of the energy ledger (mpipd.model.ledger, DESIGN §8b).
 
 Held potential energies, each *owned by one point* (a sum over that point's own
 family), so that any subset of points can be evaluated before and after an
@@ -6,10 +6,10 @@ event that changes them discontinuously (bonds breaking, a point switching to
 the bond-spring fallback):
 
 * hourglass (Eq. 15, kernels.nosb):  E_i = V_i (h_i / 2) sum_j omega_i |Y - F_i xi|^2 V_j,
-  h_i = 2 c M / tr K_i, for points on the correspondence model (spring[i] = 0);
+  h_i = 2 c M / tr K_i, for points on the correspondence model (spring[i] = CORRESPONDENCE);
 * bond-spring fallback (paper §2.1): point i's half of each intact bond inside its
   horizon, E_i = V_i sum_j (c_bb,i / 4) s^2 |xi| V_j, s = |Y|/|xi| - 1 — the
-  potential of the half-spring force (c_bb,i / 2) s Y/|Y| (spring[i] = 1 or 2);
+  potential of the half-spring force (c_bb,i / 2) s Y/|Y| (spring[i] = SPRING_K or SPRING_F);
 * contact (Eq. 40, kernels.contact): half of each broken pair's penalty potential,
   E_i = (V_i / 2) sum_j c_s omegahat (|Y| - |xi|)^2 / (2 delta) V_j for |Y| < |xi|,
   whose gradient is the contact force.
@@ -25,6 +25,7 @@ import math
 import numba
 
 from .influence import influence
+from .layout import CORRESPONDENCE, NOT_TL
 
 
 @numba.njit(cache=True)
@@ -36,7 +37,7 @@ def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg
         di = horizon[i]
         ci = infl[i]
         code = spring[i]
-        h = 2.0 * hg_modulus[i] / trK[i] if code == 0 and trK[i] > 0.0 else 0.0
+        h = 2.0 * hg_modulus[i] / trK[i] if code == CORRESPONDENCE and trK[i] > 0.0 else 0.0
         ehg = 0.0
         esp = 0.0
         eco = 0.0
@@ -61,12 +62,12 @@ def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg
             wi = influence(ci, di, r)
             if wi == 0.0:
                 continue
-            if code == 0:
+            if code == CORRESPONDENCE:
                 z0 = y0 - (F[i, 0, 0] * e0 + F[i, 0, 1] * e1 + F[i, 0, 2] * e2)
                 z1 = y1 - (F[i, 1, 0] * e0 + F[i, 1, 1] * e1 + F[i, 1, 2] * e2)
                 z2 = y2 - (F[i, 2, 0] * e0 + F[i, 2, 1] * e1 + F[i, 2, 2] * e2)
                 ehg += wi * (z0 * z0 + z1 * z1 + z2 * z2) * vol[j]
-            elif code != 3:
+            elif code != NOT_TL:
                 ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
                 s = ly / r - 1.0
                 esp += 0.25 * cbb[i] * s * s * r * vol[j]

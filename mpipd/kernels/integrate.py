@@ -8,6 +8,8 @@ Points with ``fixed[i]`` set keep u = 0 and v = 0.
 """
 import numba
 
+from .layout import CORRESPONDENCE
+
 
 @numba.njit(cache=True)
 def kick_drift(u, v, a, dt, fixed, damp, edamp):
@@ -70,7 +72,7 @@ def stress_power(sigma, d, J, dt, spring, W):
     trapezoidal rule on the stress power.
     """
     for i in range(W.shape[0]):
-        if spring[i]:
+        if spring[i] != CORRESPONDENCE:
             continue
         s = (sigma[i, 0] * d[i, 0] + sigma[i, 1] * d[i, 1] + sigma[i, 2] * d[i, 2]
              + 2.0 * (sigma[i, 3] * d[i, 3] + sigma[i, 4] * d[i, 4] + sigma[i, 5] * d[i, 5]))

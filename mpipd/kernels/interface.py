@@ -1,4 +1,4 @@
-"""Kernels of the resolution-interface correction (see :mod:`mpipd.interface`).
+"""Kernels of the resolution-interface correction (see :mod:`mpipd.model.interface`).
 
 Under a uniform first Piola stress P the gathered force density (Eq. 1 with
 dual horizons) on point i is P g_i with the purely geometric vector
@@ -15,6 +15,7 @@ import math
 import numba
 
 from .influence import influence
+from .layout import FD_H, FD_SPRING, KINV_FLAG
 
 
 @numba.njit(cache=True)
@@ -27,7 +28,7 @@ def interface_vectors(x, vol, horizon, infl, offsets, nbr, broken, kinv, points,
         g0 = g1 = g2 = 0.0
         di = horizon[i]
         ci = infl[i]
-        own = kinv[i, 9] == 0.0
+        own = kinv[i, KINV_FLAG] == 0.0
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
@@ -43,7 +44,7 @@ def interface_vectors(x, vol, horizon, infl, offsets, nbr, broken, kinv, points,
                 g1 += wi * (kinv[i, 3] * e0 + kinv[i, 4] * e1 + kinv[i, 5] * e2)
                 g2 += wi * (kinv[i, 6] * e0 + kinv[i, 7] * e1 + kinv[i, 8] * e2)
             wj = influence(infl[j], horizon[j], r) * vj
-            if wj > 0.0 and kinv[j, 9] == 0.0:
+            if wj > 0.0 and kinv[j, KINV_FLAG] == 0.0:
                 g0 += wj * (kinv[j, 0] * e0 + kinv[j, 1] * e1 + kinv[j, 2] * e2)
                 g1 += wj * (kinv[j, 3] * e0 + kinv[j, 4] * e1 + kinv[j, 5] * e2)
                 g2 += wj * (kinv[j, 6] * e0 + kinv[j, 7] * e1 + kinv[j, 8] * e2)
@@ -63,9 +64,9 @@ def subtract_ghost_force(fd, F, idx, q, active, f, fc):
         if not active[p]:
             continue
         i = idx[p]
-        if fd[i, 10] != 0.0:                  # bond-spring fallback this step: no P
+        if fd[i, FD_SPRING] != 0.0:                  # bond-spring fallback this step: no P
             continue
-        h = fd[i, 9]
+        h = fd[i, FD_H]
         for r in range(3):
             acc = 0.0
             for c in range(3):

@@ -38,6 +38,7 @@ import numpy as np
 
 from .contact import contact_force
 from .influence import influence
+from .layout import CORRESPONDENCE, FD_H, FD_SPRING, FD_VISC_L, FD_VISC_Q, NOT_TL, SPRING_F, SPRING_K
 from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
 from .viscosity import viscous_bond
 
@@ -59,7 +60,7 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
     """K^-1, tr K and gamma = sum_j omega V_j (Eq. 43) for the owned points in ``points``.
 
     A point with fewer than 3 intact bonds, or with det K <= rcond (tr K / 3)^3,
-    is marked ``spring[i] = 1`` (bond-spring fallback).  Returns how many are.
+    is marked ``spring[i] = SPRING_K`` (bond-spring fallback).  Returns how many are.
     """
     K = np.empty((3, 3))
     n_spring = 0
@@ -96,13 +97,13 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
         gamma[i] = g
         d = det3(K)
         if nb < 3 or not d > rcond * (tr / 3.0) ** 3:
-            spring[i] = 1
+            spring[i] = SPRING_K
             n_spring += 1
             for r_ in range(3):
                 for c in range(3):
                     Kinv[i, r_, c] = 0.0
         else:
-            spring[i] = 0
+            spring[i] = CORRESPONDENCE
             inv3(K, Kinv[i])
     return n_spring
 
@@ -117,7 +118,7 @@ def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kin
     N = np.empty((3, 3))
     Nd = np.empty((3, 3))
     for i in range(n):
-        if spring[i] % 2 == 1:                 # K not invertible (1) or not TL (3): no F
+        if spring[i] == SPRING_K or spring[i] == NOT_TL:         # no F
             for r in range(3):
                 for c in range(3):
                     F[i, r, c] = 1.0 if r == c else 0.0
@@ -183,7 +184,7 @@ def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kin
 
 @numba.njit(cache=True)
 def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spring, F):
-    """F (Eq. 5) of the owned points ``rows`` only (I where spring[i] is odd), into
+    """F (Eq. 5) of the owned points ``rows`` only (I where spring[i] is SPRING_K or NOT_TL), into
     F[p] for rows[p]: the same sums, in the same order, as deformation_gradients."""
     N = np.empty((3, 3))
     for p in range(rows.shape[0]):
@@ -192,7 +193,7 @@ def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spr
             for c in range(3):
                 N[r, c] = 0.0
                 F[p, r, c] = 1.0 if r == c else 0.0
-        if spring[i] % 2 == 1:
+        if spring[i] == SPRING_K or spring[i] == NOT_TL:
             continue
         di = horizon[i]
         ci = infl[i]
@@ -223,16 +224,16 @@ def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spr
 @numba.njit(cache=True)
 def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
     """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
-    fd[i, 9] = h, fd[i, 10] = 1.0 for a bond-spring point, else 0.0, with
+    fd[i, FD_H] = h, fd[i, FD_SPRING] = 1.0 for a bond-spring point, else 0.0, with
     A = c J sigma F^-T K^-1 (J = det F, c = Jfac[i] the volume factor),
     sigma = R sigma_unrot R^T, h = 2 M / tr K.
 
     ``hg_modulus[i]`` is c * M of the point's material.  Points whose K cannot
-    be inverted (``spring[i] = 1``, set by shape_tensors) use the bond-spring
+    be inverted (``spring[i] = SPRING_K``, set by shape_tensors) use the bond-spring
     fallback; so, for this step only, does a point whose F is singular or not
-    finite (``spring[i] = 2``, re-tested every step).  The points that switched
+    finite (``spring[i] = SPRING_F``, re-tested every step).  The points that switched
     between 0 and 2 in this call are written to ``toggled`` (their energy is
-    booked by the ledger).  Returns (points on code 2, points toggled).
+    booked by the ledger).  Returns (points on SPRING_F, points toggled).
     """
     n_owned = F.shape[0]
     S = np.empty((3, 3))
@@ -243,21 +244,21 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
     n_bad = 0
     n_tog = 0
     for i in range(n_owned):
-        if spring[i] % 2 == 0:
+        if spring[i] == CORRESPONDENCE or spring[i] == SPRING_F:      # F exists
             was = spring[i]
             J = det3(F[i])
             if J > 0.0 and math.isfinite(J):
-                spring[i] = 0
+                spring[i] = CORRESPONDENCE
             else:
-                spring[i] = 2          # singular (or non-finite) F this step
+                spring[i] = SPRING_F   # singular (or non-finite) F this step
                 n_bad += 1
             if spring[i] != was:
                 toggled[n_tog] = i
                 n_tog += 1
-        if spring[i]:
-            for c in range(10):
+        if spring[i] != CORRESPONDENCE:
+            for c in range(FD_SPRING):
                 fd[i, c] = 0.0
-            fd[i, 10] = 1.0
+            fd[i, FD_SPRING] = 1.0
             continue
         voigt_to_mat(sigma[i], S)
         mul3(R[i], S, T1)
@@ -272,8 +273,8 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
         for r in range(3):
             for c in range(3):
                 fd[i, 3 * r + c] = T1[r, c] - h * F[i, r, c]
-        fd[i, 9] = h
-        fd[i, 10] = 0.0
+        fd[i, FD_H] = h
+        fd[i, FD_SPRING] = 0.0
     return n_bad, n_tog
 
 
@@ -283,7 +284,7 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
-    (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, 11:13] and v; its
+    (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, FD_VISC_L], fd[:, FD_VISC_Q] and v; its
     share of f is also written to ``fv`` (for the energy ledger's viscous work).
     """
     n = offsets.shape[0] - 1
@@ -294,10 +295,10 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
         b0, b1, b2 = fd[i, 0], fd[i, 1], fd[i, 2]
         b3, b4, b5 = fd[i, 3], fd[i, 4], fd[i, 5]
         b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
-        hi = fd[i, 9]
+        hi = fd[i, FD_H]
         di = horizon[i]
         ci = infl[i]
-        si = fd[i, 10]
+        si = fd[i, FD_SPRING]
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
         for k in range(offsets[i], offsets[i + 1]):
@@ -330,17 +331,17 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
                     tx, ty, tz = g * y0, g * y1, g * y2
             wj = influence(infl[j], horizon[j], r)
             if wj > 0.0:
-                if fd[j, 10] == 0.0:
-                    tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, 9] * y0)
-                    ty += wj * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, 9] * y1)
-                    tz += wj * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, 9] * y2)
+                if fd[j, FD_SPRING] == 0.0:
+                    tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, FD_H] * y0)
+                    ty += wj * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, FD_H] * y1)
+                    tz += wj * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, FD_H] * y2)
                 else:
                     g = _spring(cbb[j], r, y0, y1, y2)
                     tx += g * y0
                     ty += g * y1
                     tz += g * y2
             if visc:
-                c = viscous_bond(wi, wj, fd[i, 11], fd[i, 12], fd[j, 11], fd[j, 12],
+                c = viscous_bond(wi, wj, fd[i, FD_VISC_L], fd[i, FD_VISC_Q], fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
                                  v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
                                  e0, e1, e2, r)
                 cv = c * vol[j]

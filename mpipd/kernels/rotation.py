@@ -22,6 +22,7 @@ import math
 import numba
 import numpy as np
 
+from .layout import NOT_TL, SPRING_K
 from .linalg import det3, inv3, mat_to_voigt, mul3, mul3_at
 
 
@@ -54,7 +55,7 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
             for c in range(3):
                 Fm[r, c] = 0.5 * (F_old[i, r, c] + F_new[i, r, c])
         Jm = det3(Fm)
-        if spring[i] % 2 == 1 or not (Jm > 0.0 and math.isfinite(Jm)):
+        if spring[i] == SPRING_K or spring[i] == NOT_TL or not (Jm > 0.0 and math.isfinite(Jm)):
             for c in range(6):                  # no continuum kinematics this step
                 d[i, c] = 0.0
             J[i] = 1.0

@@ -38,6 +38,7 @@ import math
 import numba
 import numpy as np
 
+from .layout import GD_P, GD_V
 from .linalg import inv3
 
 #: fewest current neighbours, and smallest det M / (tr M / 3)^3, for a gas point to act
@@ -144,8 +145,8 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         bb = V_old * trL * dt                   # W_b = p^{n+1} bb (0 if singular)
         e[k] = (e[k] * V0[k] - 0.5 * W_a - 0.5 * lk * f * bb) / (V0[k] + 0.5 * lk * w * bb / VR)
         p = lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0
-        gd[i, 6] = V_new
-        gd[i, 7] = p
+        gd[i, GD_V] = V_new
+        gd[i, GD_P] = p
         if singular or p == 0.0:
             for c in range(6):
                 gd[i, c] = 0.0

@@ -17,25 +17,27 @@ which is Eq. 42 with gamma delta -> tr K / (3 omega); it enters Eq. 1 on the
 left, so the force on i is -sum_j (T_v,i<xi> - T_v,j<-xi>) V_j.  The linear term
 is dissipative bond by bond; the quadratic one resists compression.
 c0 = sqrt(K / rho0) is the bulk wave speed with the positive reference modulus.
-Per point the halo carries fd[:, 11] = a C_l rho0 c0 and fd[:, 12] = a C_q rho0 phi^2,
+Per point the halo carries fd[:, FD_VISC_L] = a C_l rho0 c0 and fd[:, FD_VISC_Q] = a C_q rho0 phi^2,
 a = 3 v^2 / tr K (both zero where phi >= 0).
 """
 import numba
 
+from .layout import CORRESPONDENCE, FD_VISC_L, FD_VISC_Q
+
 
 @numba.njit(cache=True)
 def viscosity_data(dil, gamma, J, trK, spring, cl_rho_c, cq_rho, fd):
-    """Fill fd[:, 11:13] of owned points (see module docstring)."""
+    """Fill fd[:, FD_VISC_L], fd[:, FD_VISC_Q] of owned points (see module docstring)."""
     for i in range(dil.shape[0]):
-        fd[i, 11] = 0.0
-        fd[i, 12] = 0.0
-        if spring[i] or gamma[i] <= 0.0:
+        fd[i, FD_VISC_L] = 0.0
+        fd[i, FD_VISC_Q] = 0.0
+        if spring[i] != CORRESPONDENCE or gamma[i] <= 0.0:
             continue
         phi = dil[i] / gamma[i]
         if phi < 0.0:
             a = 3.0 * J[i] * J[i] / trK[i]
-            fd[i, 11] = a * cl_rho_c[i]
-            fd[i, 12] = a * cq_rho[i] * phi * phi
+            fd[i, FD_VISC_L] = a * cl_rho_c[i]
+            fd[i, FD_VISC_Q] = a * cq_rho[i] * phi * phi
 
 
 @numba.njit(cache=True, inline="always")

@@ -2,7 +2,7 @@
 
 A material is a frozen dataclass of its scene parameters, registered in
 :data:`MATERIALS` under the name a scene's ``model`` key selects.  The
-correspondence machinery (:mod:`mpipd.correspondence`) computes F, the rotation
+correspondence machinery (:mod:`mpipd.model.correspondence`) computes F, the rotation
 R, the left stretch V and the *unrotated* rate of deformation d for every point;
 a material only turns d and its own history into the unrotated Cauchy stress.
 
@@ -27,7 +27,7 @@ Interface (see :class:`mpipd.materials.base.Material`):
     names of per-point fields the material needs in the halo besides the
     correspondence data (none for elastic).
 """
-from ..schema import Registry
+from ..input.schema import Registry
 
 MATERIALS = Registry("material model", "model")
 

@@ -5,7 +5,7 @@ import math
 
 import numba
 
-from ..schema import positive
+from ..input.schema import positive
 
 
 @numba.njit(cache=True)

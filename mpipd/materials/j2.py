@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..schema import positive
+from ..input.schema import positive
 from . import MATERIALS
 from .base import Material
 from .tension import TensionFailure

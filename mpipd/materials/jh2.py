@@ -35,7 +35,7 @@ Per point and step, in the unrotated frame (d from Eq. 6, dt):
    ``plastic``).  In compression p only grows, so no yield step changes its sign.
 7. sigma = S - (p_EOS + dp) I (Eq. 35); the correspondence module rotates it (Eq. 36).
 
-A failed point carries no stress; its bonds break (mpipd.failure).
+A failed point carries no stress; its bonds break (mpipd.model.failure).
 """
 from __future__ import annotations
 
@@ -45,13 +45,12 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..schema import fail, join, non_negative, positive
+from ..input.schema import fail, join, non_negative, positive
+from ..kernels.layout import MODE_PLASTIC, MODE_TENSILE
 from . import MATERIALS
 from .base import Material
 from .tension import TensionFailure
 
-MODE_PLASTIC = 1     # D reached 1
-MODE_TENSILE = 2     # p* < -T*
 
 
 @numba.njit(cache=True, inline="always")

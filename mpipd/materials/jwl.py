@@ -19,7 +19,7 @@ Isentropes of JWL are p_s(V) = A exp(-R1 V) + B exp(-R2 V) + C V^-(1 + w), with
 e_s(V) = (A/R1) exp(-R1 V) + (B/R2) exp(-R2 V) + (C/w) V^-w.
 
 The scene material ``model = "jwl"`` (:class:`Explosive`) is the explosive gas:
-updated-Lagrangian points (mpipd.gas) with this EOS, a programmed detonation
+updated-Lagrangian points (mpipd.model.gas) with this EOS, a programmed detonation
 and its own damping; it has no total-Lagrangian bonds.
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numba
 from scipy.optimize import minimize_scalar
 
-from ..schema import fail, join, non_negative, positive
+from ..input.schema import fail, join, non_negative, positive
 from . import MATERIALS
 
 
@@ -138,7 +138,7 @@ class Explosive(JWL):
         return {}
 
     def update(self, idx, d, J, dt, sigma, mode, state):
-        """The gas has no correspondence stress (mpipd.gas handles it)."""
+        """The gas has no correspondence stress (mpipd.model.gas handles it)."""
 
     def elastic_energy(self, idx, sigma, J, mode, state, W, out):
         """No correspondence stress, no elastic energy (the gas's own energy is

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numba
 
-from ..schema import fail, join, non_negative, positive
+from ..input.schema import fail, join, non_negative, positive
+from ..kernels.layout import MODE_TENSION
 
-MODE_TENSION = 3
 
 
 @numba.njit(cache=True, inline="always")

@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from .. import __version__
+from ..kernels.layout import GD_A, GD_P, GD_V
 
 FORMAT = "mpipd-checkpoint-1"
 
@@ -67,9 +68,9 @@ def _per_point(sim) -> dict:
             out[f"state{mid}/{key}"] = full
     if sim.gas is not None:                       # volume, pressure, energy of the gas
         gas = sim.gas
-        out["gas_V"] = gas.gd[:n, 6]
-        out["gas_p"] = gas.gd[:n, 7]
-        out["gas_A"] = gas.gd[:n, :6]             # the last force (its work ends next step)
+        out["gas_V"] = gas.gd[:n, GD_V]
+        out["gas_p"] = gas.gd[:n, GD_P]
+        out["gas_A"] = gas.gd[:n, GD_A:GD_V]             # the last force (its work ends next step)
         out["gas_Vw"] = gas.V_w[:n]               # the last step's pair weights
         e = np.zeros(n)
         e[gas.gas_idx] = gas.e
@@ -150,7 +151,7 @@ def _write(sim, tmp, scene_text, overrides, run_id):
 
 @dataclass(frozen=True)
 class Info:
-    """What a checkpoint says about itself (mpipd.rundir matches it to a run file)."""
+    """What a checkpoint says about itself (mpipd.output.rundir matches it to a run file)."""
     scene: str
     overrides: list
     step: int
@@ -301,8 +302,8 @@ def restore(sim, path) -> None:
         fam.broken[:] = np.isin(key, want).astype(np.uint8)
     if sim.gas is not None:
         gas = sim.gas
-        gas.gd[:n, 6], gas.gd[:n, 7] = data["gas_V"], data["gas_p"]
-        gas.gd[:n, :6] = data["gas_A"]
+        gas.gd[:n, GD_V], gas.gd[:n, GD_P] = data["gas_V"], data["gas_p"]
+        gas.gd[:n, GD_A:GD_V] = data["gas_A"]
         gas.V_w[:n] = data["gas_Vw"]
         sim.halo.exchange(gas.V_w)
         gas.e[:] = data["gas_e"][gas.gas_idx]

@@ -2,10 +2,10 @@
 
 A run directory ``OUT`` holds one run's files::
 
-    OUT/run.h5              the run file (mpipd.output), attribute ``run_id``
+    OUT/run.h5              the run file (mpipd.output.writer), attribute ``run_id``
     OUT/run.xdmf            its ParaView index
     OUT/run.log             the log (appended to by restarts)
-    OUT/checkpoint.h5       the last checkpoint (mpipd.checkpoint), attribute ``run_id``
+    OUT/checkpoint.h5       the last checkpoint (mpipd.output.checkpoint), attribute ``run_id``
     OUT/checkpoint_failed.h5  the state at a blow-up
 
 A run draws a random **run id** when it creates ``run.h5`` and writes it into
@@ -27,7 +27,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from .parallel import Fatal
+from ..parallel.team import Fatal
 
 RUN_FILE = "run.h5"
 CHECKPOINT = "checkpoint.h5"

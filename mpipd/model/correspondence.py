@@ -23,8 +23,10 @@ import math
 
 import numpy as np
 
-from .kernels import energy, integrate, nosb, rotation
-from .kernels.viscosity import viscosity_data
+from ..kernels import energy, integrate, nosb, rotation
+from ..kernels.layout import (CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F,
+                             SPRING_K)
+from ..kernels.viscosity import viscosity_data
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
 RCOND = 1e-8
@@ -74,13 +76,13 @@ class Correspondence:
         self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
         self.J_end = np.ones(n)                 # c det F at the end of the step (materials)
         self.Jfac = np.ones(n)                  # volume factor c (rebuild_shape)
-        self.toggled = np.zeros(n, np.int64)    # points that switched to/from code 2
+        self.toggled = np.zeros(n, np.int64)    # points that switched to/from SPRING_F
         self.W = np.zeros(n)                    # strain energy per reference volume
         self.gamma = np.zeros(n)                # sum_j omega V_j (Eq. 43)
         self.contact = bool(contact)
         self.viscosity = viscosity
         # force data of owned + ghost points: B (9), h, fallback flag [, viscosity (2)]
-        self.fd = np.zeros((nl, 13 if viscosity is not None else 11))
+        self.fd = np.zeros((nl, FD_WIDTH_VISCOUS if viscosity is not None else FD_WIDTH))
         self.dil = np.zeros(n if viscosity is not None else 0)
         if viscosity is not None:
             rho = np.array([m.density for m in mats])[points.material[:n]]
@@ -93,7 +95,7 @@ class Correspondence:
         bulk = np.array([m.bulk_modulus for m in mats])[points.material]
         self.cbb = 18.0 * bulk / (math.pi * points.horizon ** 4)
         self.n_spring = 0
-        # points outside the total-Lagrangian model (the gas): fallback code 3, never counted
+        # points outside the total-Lagrangian model (the gas): code NOT_TL, never counted
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
 
     # ---------------------------------------------------------------- steps
@@ -115,17 +117,17 @@ class Correspondence:
         p, fam = self.points, self.families
         if which is None:
             which = np.arange(p.n_owned, dtype=np.int64)
-        before = self.spring[which] == 0
+        before = self.spring[which] == CORRESPONDENCE
         nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
                            fam.broken, self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
-        self.spring[self.not_tl] = 3
+        self.spring[self.not_tl] = NOT_TL
         if u is not None and len(which):
             Fn = np.empty((len(which), 3, 3))
             nosb.gradients_of(which, p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
                               fam.nbr, fam.broken, self.Kinv, self.spring, Fn)
             j_old = np.linalg.det(self.F[which])
             j_new = np.linalg.det(Fn)
-            ok = before & (self.spring[which] == 0) & (j_old > 0) & (j_new > 0)
+            ok = before & (self.spring[which] == CORRESPONDENCE) & (j_old > 0) & (j_new > 0)
             self.Jfac[which[ok]] *= j_old[ok] / j_new[ok]
             self.F[which] = Fn
             self.F_old[which] = Fn
@@ -134,7 +136,7 @@ class Correspondence:
 
     def count_spring(self) -> int:
         """Owned total-Lagrangian points on the bond-spring fallback."""
-        return int(np.count_nonzero((self.spring == 1) | (self.spring == 2)))
+        return int(np.count_nonzero((self.spring == SPRING_K) | (self.spring == SPRING_F)))
 
     def deform(self, u, v):
         p, fam = self.points, self.families
@@ -145,7 +147,7 @@ class Correspondence:
     def initial_volume(self):
         """J_end = c det F of the current F (the start of a run, before any step)."""
         J = np.linalg.det(self.F)
-        ok = (self.spring % 2 == 0) & (J > 0)
+        ok = ((self.spring == CORRESPONDENCE) | (self.spring == SPRING_F)) & (J > 0)
         self.J_end[:] = np.where(ok, self.Jfac * J, 1.0)
 
     def rotate(self, dt: float):
@@ -165,7 +167,7 @@ class Correspondence:
 
     def force_data(self) -> np.ndarray:
         """Force data of the owned points; returns the points that switched to or
-        from the singular-F fallback (code 2) in this call."""
+        from the singular-F fallback (SPRING_F) in this call."""
         n_bad, n_tog = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK,
                                        self.spring, self.hg_modulus, self.Jfac, self.fd,
                                        self.toggled)

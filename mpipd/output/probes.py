@@ -4,7 +4,7 @@ Each probe is the lattice point nearest its ``position`` (lowest gid on a tie),
 among the points of its ``part`` if it names one (a probe farther than that
 point's horizon from it is refused as outside the body; one moved by more
 than dx is reported in the run log) (a part name matches the part
-and its zones ``<part>.band``, ``<part>.0``, ... of :meth:`mpipd.scene.Part.zones`,
+and its zones ``<part>.band``, ``<part>.0``, ... of :meth:`mpipd.input.scene.Part.zones`,
 so ``part = "rock"`` samples the rock whatever its resolution bands); the rank
 that owns it records, every step,
 
@@ -27,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .materials.jh2 import jh2_strength
-from .schema import fail
+from ..materials.jh2 import jh2_strength
+from ..input.schema import fail
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
 
@@ -152,7 +152,7 @@ class Probes:
 
     def create(self, h5, n_rows: int):
         """Collective: datasets for every probe (all ranks call this)."""
-        from .output import growable
+        from .writer import growable
         self.dsets = {}
         for k, pr in enumerate(self.probes):
             grp = h5.require_group(f"probes/{pr.name}")

@@ -3,7 +3,7 @@
 Nothing here generates the model's 3-D points.  Point counts come from the
 layer table (one row per part and z level).  Bonds are counted per layer from
 the parts' 2-D cross-sections: a point's family is every lattice point within
-max(delta_i, delta_j) (:mod:`mpipd.families`), so the bonds of one layer are
+max(delta_i, delta_j) (:mod:`mpipd.model.families`), so the bonds of one layer are
 the pairs between its cross-section and each cross-section within reach in z,
 closer in x-y than sqrt(R^2 - dz^2) — counted with 2-D KD trees and cached per
 (part, part, distance).  That is the solver's count (up to round-off at
@@ -36,8 +36,8 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .decomp import decompose, halo_width, replicated_parts
-from .geometry import LayerTable
+from .parallel.decomp import decompose, halo_width, replicated_parts
+from .input.geometry import LayerTable
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)

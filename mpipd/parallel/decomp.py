@@ -1,6 +1,6 @@
 """Slab decomposition along the thickness axis z.
 
-The model is a table of layers (:class:`mpipd.geometry.LayerTable`) in gid
+The model is a table of layers (:class:`mpipd.input.geometry.LayerTable`) in gid
 order.  :func:`decompose` cuts it into ``n`` contiguous runs of whole z levels
 with balanced point counts, so rank r owns one contiguous gid range.  A rank's
 *ghosts* are every layer it does not own whose z lies within ``halo`` of its
@@ -9,7 +9,7 @@ points and the crossing-bond rule of bond breakage (paper §2.4).
 
 A slab thinner than the halo is handled, not refused: ghosts may belong to any
 rank within reach, not just the neighbours, and the halo exchanges directly
-with each of them (see :mod:`mpipd.halo`).  Only a rank with no z level at all
+with each of them (see :mod:`mpipd.parallel.halo`).  Only a rank with no z level at all
 is refused.
 
 Replicated parts.  The explosive gas moves far from its reference slab, and
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import LayerTable, fill_layers
-from .kernels.influence import CODES as INFLUENCE
+from ..input.geometry import LayerTable, fill_layers
+from ..kernels.influence import CODES as INFLUENCE
 
 
 class DecompositionError(ValueError):

@@ -8,7 +8,7 @@ cubes and every point has volume ``dx**3``.
 Because a shape's cross-section is the same at every z level, the model is
 described completely by a table of *layers* — one per (part, z level) — each
 knowing its point count without generating a single point.  The decomposition
-(:mod:`mpipd.decomp`) balances ranks on that table, and each rank then
+(:mod:`mpipd.parallel.decomp`) balances ranks on that table, and each rank then
 generates only the layers it owns or needs as ghosts.
 
 Within a layer, points are ordered by (y, x); global ids run over layers in
@@ -280,7 +280,7 @@ def prisms_inside(parts, x: np.ndarray, radius: np.ndarray, n_dir: int = 64,
 
     There the body near x is its cross-section extruded, so a single-resolution
     lattice is mirror-symmetric in x and y about x — the test of
-    :class:`mpipd.interface.InterfaceCorrection` for keeping only a z face's
+    :class:`mpipd.model.interface.InterfaceCorrection` for keeping only a z face's
     traction.  Disk samples: the centre and ``n_dir`` directions on each ring."""
     out = np.ones(len(x), dtype=bool)
     if not len(x):

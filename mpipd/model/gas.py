@@ -6,7 +6,7 @@ material.
   gas, which moves far from its reference slab, and is a few per cent of a model),
   and every point of the ``interacts_with`` solids: a gas point may come within its
   horizon of any of them, however far it is from its owner's slab
-  (:func:`mpipd.decomp.replicated_parts`).
+  (:func:`mpipd.parallel.decomp.replicated_parts`).
 * Families live in the current configuration: for each owned gas point, the gas
   and the ``interacts_with`` solids within the gas horizon; for each owned such
   solid, the gas points whose horizon reaches it.  No total-Lagrangian bond
@@ -27,7 +27,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .families import _csr_by_row
-from .kernels.ul import gas_gather, gas_update
+from ..kernels.layout import GD_P, GD_V, GD_WIDTH
+from ..kernels.ul import gas_gather, gas_update
 
 #: Verlet skin of the gas families, as a fraction of the gas horizon
 SKIN = 0.2
@@ -48,8 +49,8 @@ class Gas:
                                        | np.isin(p.material, [names.index(a) for a in acts]))
         self.rows = self.eligible[self.eligible < n]
         self.gas_idx = np.flatnonzero(self.is_gas[:n]).astype(np.int64)
-        self.gd = np.zeros((p.n_local, 8))                  # A (6), V, p
-        self.gd[self.is_gas.astype(bool), 6] = p.volume[self.is_gas.astype(bool)]
+        self.gd = np.zeros((p.n_local, GD_WIDTH))           # A (6), V, p
+        self.gd[self.is_gas.astype(bool), GD_V] = p.volume[self.is_gas.astype(bool)]
         self.V0 = p.volume[self.gas_idx].copy()
         self.e = np.full(len(self.gas_idx), self.mat.e0)
         m = self.mat
@@ -60,7 +61,7 @@ class Gas:
         self.gas_horizon = np.where(self.is_gas.astype(bool), p.horizon, 0.0)
         self.reach = sim.team.max(float(self.gas_horizon.max()) if p.n_local else 0.0)
         self.V_ratio = np.ones(n)                # V_w / V0 of the owned gas (1 elsewhere)
-        self.V_w = self.gd[:, 6].copy()          # this step's pair weights (start-of-step V)
+        self.V_w = self.gd[:, GD_V].copy()          # this step's pair weights (start-of-step V)
         self.V_pw = self.V_w.copy()              # the last step's
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
@@ -105,14 +106,14 @@ class Gas:
         p, m = self.points, self.mat
         y = self.y = p.x + u                    # current positions, kept for gather()
         self.search(y)
-        self.V_pw, self.V_w = self.V_w, self.gd[:, 6].copy()
+        self.V_pw, self.V_w = self.V_w, self.gd[:, GD_V].copy()
         self.n_singular = gas_update(
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas)
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
-            self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, 7].max()))
+            self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
 
     def gather(self, u, f):
         """UL forces into f; u must be the displacement update() last saw."""
@@ -128,5 +129,5 @@ class Gas:
     def pressure(self) -> np.ndarray:
         """Gas pressure over all owned points (0 elsewhere)."""
         out = np.zeros(self.points.n_owned)
-        out[self.gas_idx] = self.gd[self.gas_idx, 7]
+        out[self.gas_idx] = self.gd[self.gas_idx, GD_P]
         return out

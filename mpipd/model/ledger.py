@@ -52,7 +52,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from .kernels import energy as kern
+from ..kernels import energy as kern
+from ..kernels.layout import INTACT, SPRING_K
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
@@ -184,7 +185,7 @@ class Ledger:
         ke = 0.5 * float(np.dot(m, np.einsum("ij,ij->i", sim.v[:n], sim.v[:n])))
         integ = self.integrator(sim)
         eel = c.elastic_energy(mode)
-        gone = (mode[:n] != 0) | (c.spring == 1)
+        gone = (mode[:n] != INTACT) | (c.spring == SPRING_K)
         keep = ~gone
         elastic = float(np.dot(vol[keep], eel[keep]))
         plastic = float(np.dot(vol[keep], c.W[keep] - eel[keep]))

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels.energy import update_peaks
+from ..kernels.energy import update_peaks
+from ..kernels.layout import GD_P
 
 NAMES = ("peak_pressure", "peak_sigma_rr", "peak_speed")
 
@@ -38,6 +39,6 @@ class Peaks:
         c, a = sim.corr, self.arrays
         gas = sim.gas
         gidx = gas.gas_idx if gas is not None else self._empty
-        gp = gas.gd[:, 7] if gas is not None else self._nogas
+        gp = gas.gd[:, GD_P] if gas is not None else self._nogas
         update_peaks(sim.points.x, sim.v, c.sigma, c.R, gidx, gp, self.center[0],
                      self.center[1], a["peak_pressure"], a["peak_sigma_rr"], a["peak_speed"])

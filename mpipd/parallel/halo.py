@@ -1,6 +1,6 @@
 """Halo exchange: owned values -> the ghost copies on other ranks.
 
-The plan comes from :meth:`mpipd.decomp.Slabs.plan`: for every peer rank, one
+The plan comes from :meth:`mpipd.parallel.decomp.Slabs.plan`: for every peer rank, one
 contiguous local slice of ghosts to receive and one contiguous slice of owned
 points to send.  Arrays are exchanged in place through mpi4py's buffer
 interface (``Irecv``/``Isend`` straight into and out of the array slices, no

@@ -27,7 +27,7 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .kernels.breakage import break_bonds, pairs_from_lists, pd_damage
+from ..kernels.breakage import break_bonds, pairs_from_lists, pd_damage
 
 class Failure:
     def __init__(self, points, families, halo, corr, damping: float, damp, tl, ledger=None):

@@ -28,7 +28,7 @@ side of every bond (mpipd.kernels.influence): "quadratic" (delta - |xi|)^2, the
 paper's and the default; "constant" 1, Peridigm's default; "inverse"
 delta / |xi|.  Graded rings and an inner band inherit it.
 
-Bad input raises :class:`mpipd.schema.SceneError` with one line naming the key.
+Bad input raises :class:`mpipd.input.schema.SceneError` with one line naming the key.
 """
 from __future__ import annotations
 
@@ -42,10 +42,10 @@ from typing import Any
 import numpy as np
 
 from .geometry import SHAPES
-from .kernels.influence import CODES as INFLUENCE
+from ..kernels.influence import CODES as INFLUENCE
 from .loads import BOUNDARIES, INITIAL, LOADS
-from .materials import MATERIALS
-from .probes import Probe, part_matches
+from ..materials import MATERIALS
+from ..output.probes import Probe, part_matches
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3
@@ -209,7 +209,7 @@ class Solver:
     phi = 1 (the paper's 0.2 per microsecond is 2e5 1/s); 0 switches it off.
     ``contact`` turns on Eq. 40 on broken bonds; ``viscosity`` Eqs. 42–44.
     ``interface_correction`` removes the ghost force where dx or the horizon
-    changes (mpipd.interface); it only exists in scenes whose parts differ.
+    changes (mpipd.model.interface); it only exists in scenes whose parts differ.
     ``refresh_after_break`` recomputes the forces after a step in which bonds
     broke, so the next half kick uses the broken state's forces: velocity Verlet
     otherwise applies the pre-break force for one more half step, a first-order
@@ -231,7 +231,7 @@ class Solver:
 class Output:
     """``every`` (steps between frames), ``fields``, ``checkpoint_every``, and
     ``peak_center``: the (x, y) of the z axis about which ``peak_sigma_rr`` is
-    radial (mpipd.peaks)."""
+    radial (mpipd.output.peaks)."""
     every: int = 10
     fields: tuple[str, ...] = ("u", "v")
     checkpoint_every: int = 0         # steps between checkpoints; 0 = only on signal/stop
@@ -346,7 +346,7 @@ class Scene:
 
 def builtin_scenes() -> dict[str, Path]:
     """Built-in scene name -> file."""
-    root = resources.files("mpipd") / "scenes"
+    root = resources.files("mpipd.input") / "scenes"
     return {Path(p.name).stem: Path(str(p)) for p in root.iterdir() if p.name.endswith(".toml")}
 
 
@@ -435,7 +435,7 @@ class Case:
 
 def cases(scene_name: str) -> dict[str, Case]:
     """The named cases of a built-in scene (``mpipd/scenes/cases/<scene>.toml``)."""
-    f = resources.files("mpipd") / "scenes" / "cases" / f"{scene_name}.toml"
+    f = resources.files("mpipd.input") / "scenes" / "cases" / f"{scene_name}.toml"
     if not f.is_file():
         return {}
     raw = tomllib.loads(f.read_text())

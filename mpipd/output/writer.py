@@ -13,7 +13,7 @@ does not depend on the number of ranks that wrote it::
     /fields/<name>          (n_frames, N[, k])   u, v, stress, stress_work, elastic_energy,
                                                  peak_* (running peaks), ...
     /time                   (n_frames,)
-    /energy/<term>          (n_frames,)  the energy ledger (mpipd.ledger.TERMS)
+    /energy/<term>          (n_frames,)  the energy ledger (mpipd.model.ledger.TERMS)
     /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
@@ -34,11 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .kernels.linalg import VOIGT
-from .ledger import TERMS
+from .. import __version__
+from ..kernels.linalg import VOIGT
+from ..model.ledger import TERMS
 from .peaks import NAMES as PEAKS
-from .scene import OUTPUT_FIELDS
+from ..input.scene import OUTPUT_FIELDS
 
 
 def git_commit() -> str:
@@ -112,7 +112,7 @@ class Writer:
         """Create the run file for run ``run_id`` — or, with ``resume``, reopen it and
         continue after the frames up to the simulation's current step (restart).
         A restart may change the run length: the frame and probe datasets grow or
-        shrink along their first axis (mpipd.rundir.check_restart refuses the rest)."""
+        shrink along their first axis (mpipd.output.rundir.check_restart refuses the rest)."""
         import h5py
         self.path = Path(path)
         self.sim = sim
@@ -175,7 +175,7 @@ class Writer:
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8",
                                           **growable((self.n_frames,)))
         eg = self.f.create_group("energy")
-        eg.attrs["doc"] = ("energy ledger (J), see mpipd.ledger: held = kinetic + integrator + "
+        eg.attrs["doc"] = ("energy ledger (J), see mpipd.model.ledger: held = kinetic + integrator + "
                            "elastic + hourglass + spring + contact + gas; dissipated = plastic "
                            "+ removed + viscous + damping + gas_damping + interface; balance = "
                            "(initial + external - held - dissipated) / scale")

@@ -51,8 +51,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import balls_inside, prisms_inside
-from .kernels import interface as kern
+from ..input.geometry import balls_inside, prisms_inside
+from ..kernels import interface as kern
+from ..kernels.layout import CORRESPONDENCE, KINV_FLAG, KINV_WIDTH
 
 #: |g_i| dx_i above this is a ghost force (round-off in a uniform lattice is ~1e-14)
 G_TOL = 1e-12
@@ -70,13 +71,13 @@ class InterfaceCorrection:
         p, fam = points, families
         n = p.n_owned
         # K^-1 and a no-K flag for every local point (ghosts from their owners)
-        kinv = np.zeros((p.n_local, 10))
+        kinv = np.zeros((p.n_local, KINV_WIDTH))
         kinv[:n, :9] = corr.Kinv.reshape(n, 9)
-        kinv[:n, 9] = (corr.spring != 0).astype(float)
-        kinv[n:, 9] = 1.0
+        kinv[:n, KINV_FLAG] = (corr.spring != CORRESPONDENCE).astype(float)
+        kinv[n:, KINV_FLAG] = 1.0
         halo.exchange(kinv)
         near = self._near_interface(p, fam, halo)
-        cand = np.flatnonzero(tl[:n] & (corr.spring == 0) & near).astype(np.int64)
+        cand = np.flatnonzero(tl[:n] & (corr.spring == CORRESPONDENCE) & near).astype(np.int64)
         g = np.zeros((len(cand), 3))
         kern.interface_vectors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
                                fam.broken, kinv, cand, g)
