@@ -54,7 +54,9 @@ JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
 GAS_LOCAL, GAS_OWNED = 90, 32   # gas force data (8), flags, gas horizon, pair weights (2 steps);
 #                                 UL offsets, V ratio, damping, the ledger's damping energy
 PEAKS_OWNED = 24                # peak_pressure, peak_sigma_rr, peak_speed (if asked for)
-BYTES_PER_GAS_POINT = 48        # index, V0, e, lighting time, eligible/row lists
+BYTES_PER_GAS_POINT = 40        # index, V0, e, lighting time, not-TL index
+BYTES_PER_UL_POINT = 16         # the UL search lists (eligible, rows): the gas and the
+#                                 points of its interacts_with solids, on every rank
 
 
 def is_gas_part(scene, part) -> bool:
@@ -63,8 +65,9 @@ def is_gas_part(scene, part) -> bool:
 
 def memory_model(scene) -> tuple[int, int]:
     """(bytes per local point, bytes per owned point) for the scene's features; a
-    scene with an explosive adds BYTES_PER_GAS_POINT per gas point on every rank
-    (plus its current-configuration families)."""
+    scene with an explosive adds BYTES_PER_GAS_POINT per gas point and
+    BYTES_PER_UL_POINT per point the gas searches (gas and ``interacts_with``
+    solids) on every rank (plus its current-configuration families)."""
     local, owned = BYTES_PER_LOCAL_POINT, BYTES_PER_OWNED_POINT
     gas = any(is_gas_part(scene, q) for q in scene.parts)
     if gas:
@@ -176,7 +179,8 @@ def check_report(scene, ranks: int) -> str:
     out = [f"scene {scene.name!r}: {scene.scene.description}".rstrip(": ")]
     out.append(f"  steps: {scene.time.n_steps} of dt = {dt:.4e} s "
                f"(t_end = {scene.time.n_steps * dt:.4e} s)")
-    gas_points = 0
+    gas_points = ul_points = 0
+    ul_parts = set(replicated_parts(scene))      # what the gas searches: gas + interacts_with
     part_dt = {}
     for k, p in enumerate(scene.parts):
         sel = table.part == k
@@ -185,6 +189,8 @@ def check_report(scene, ranks: int) -> str:
         mat = scene.materials[p.material]
         if is_gas_part(scene, p):
             gas_points += npts
+        if k in ul_parts:
+            ul_points += npts
         dt_sa, dt_cfl = part_dt[k] = stable_dt(p, mat)
         fam = len(bulk_family(p.dx, p.horizon))
         out.append(f"  part {p.name!r}: {p.shape.registry_name}, material {p.material!r} "
@@ -253,7 +259,7 @@ def check_report(scene, ranks: int) -> str:
         a, b = slabs.owned(r)
         nb = int(bonds[a:b].sum())
         mem = (per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * nb
-               + BYTES_PER_GAS_POINT * gas_points)
+               + BYTES_PER_GAS_POINT * gas_points + BYTES_PER_UL_POINT * ul_points)
         thick = z1 - z0 + float(scene.max_dx)
         recv, _ = slabs.plan(r)
         peers = len({e[0] for e in recv})

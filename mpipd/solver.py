@@ -39,6 +39,7 @@ from .kernels.layout import CORRESPONDENCE, N_MODES, SPRING_F
 from .model.ledger import Energies, Ledger
 from .output.peaks import Peaks
 from .output.probes import Probes
+from .state import AUX, LAST, LOCAL, State
 
 
 class Unstable(RuntimeError):
@@ -67,12 +68,23 @@ class Simulation:
 
         n = p.n_owned
         names = list(scene.materials)
-        self.rho = np.array([scene.materials[m].density for m in names])[p.material[:n]]
-        self.u = np.zeros((p.n_local, 3))
-        self.v = np.zeros((p.n_local, 3))
-        self.a = np.zeros((n, 3))
-        self.f = np.zeros((n, 3))
-        self.fixed = np.zeros(n, dtype=np.uint8)
+        st = self.state = State(n, p.n_local)
+        p.register(st)
+        st.add("tl", "solver", self.tl, rows=LOCAL)
+        self.families.register(st)
+        self.rho = st.add("rho", "solver", np.array([scene.materials[m].density
+                                                     for m in names])[p.material[:n]])
+        self.u = st.add("u", "solver", np.zeros((p.n_local, 3)), rows=LOCAL, exchanged=True,
+                        checkpoint=True, output="u")
+        self.v = st.add("v", "solver", np.zeros((p.n_local, 3)), rows=LOCAL, exchanged=True,
+                        checkpoint=True, output="v")
+        self.a = st.add("a", "solver", np.zeros((n, 3)), checkpoint=True, restore=LAST)
+        self.f = st.add("f", "solver", np.zeros((n, 3)))
+        self.fixed = st.add("fixed", "solver", np.zeros(n, dtype=np.uint8))
+        # failure flags (0 intact, layout.MODE_*): set by the materials and the tension
+        # model, exchanged and acted on by Failure, read by the interface correction
+        self.mode = st.add("mode", "solver", np.zeros(p.n_local, np.uint8), rows=LOCAL,
+                           exchanged=scene.can_fail, checkpoint=True)
         for bc in scene.boundaries:
             self.fixed |= bc.mask(p.x[:n]).astype(np.uint8)
         for ic in scene.initial:
@@ -82,32 +94,45 @@ class Simulation:
         sv = scene.solver
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
                                    contact=sv.contact, viscosity=sv.viscosity, tl=self.tl)
+        self.corr.register(st, self.mode)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
         # the ghost-force correction exists only where dx or the horizon changes
         tl_parts = [q for k, q in enumerate(scene.parts) if k not in gas_parts]
         self.interface = (InterfaceCorrection(p, self.families, self.halo, self.corr, self.tl,
                                               tl_parts)
                           if interface_needed(scene, tl_parts) else None)
+        if self.interface is not None:
+            self.interface.register(st)
         # damping (Eq. 41 for phi = 1, and the gas's own), only if some is asked for
         needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
-        self.damp = np.zeros(n) if needs_damp else np.zeros(0)
+        self.damp = st.add("damp", "solver", np.zeros(n if needs_damp else 0))
         # failure and bond breakage exist only if some material can fail
         self.ledger = Ledger(n, damped=len(self.damp) > 0, viscous=sv.viscosity is not None,
                              n_interface=len(self.interface.idx) if self.interface else 0)
+        self.ledger.register(st, self.interface)
         self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping, self.damp,
-                                self.tl, self.ledger) if scene.can_fail else None)
-        self.mode = self.failure.mode if self.failure else np.zeros(p.n_local, np.uint8)
+                                self.tl, self.mode, self.ledger) if scene.can_fail else None)
+        if self.failure is not None:
+            self.failure.register(st)
         # the explosive gas exists only if the scene has one
         self.gas = Gas(self) if gas_parts else None
         if self.gas is not None:
+            self.gas.register(st)
             self.damp[self.gas.gas_idx] = self.gas.mat.damping
         # time-dependent body forces (none: no arrays, no calls)
         self.loads = [ld.prepare(scene.parts, p) for ld in scene.loads]
         self._b_prev = [np.zeros_like(pl.g) for pl in self.loads]
+        for k, pl in enumerate(self.loads):
+            st.add(f"load{k}_idx", "loads", pl.idx, rows=AUX)
+            st.add(f"load{k}_g", "loads", pl.g, rows=pl.idx)
+            st.add(f"load{k}_b", "loads", get=lambda k=k: self._b_prev[k], rows=pl.idx)
         self.external_work = 0.0
+        st.scalar("external_work", "loads", lambda: self.external_work, self._set_work)
+        st.scalar("bonds_broken", "failure", self.bonds_broken_here, self._set_broken)
         self.step_count = 0
         self.t = 0.0
         self.peaks = Peaks(self, scene.output)
+        self.peaks.register(st)
         self.initialize()
         self.probes = Probes(self, scene.probes) if scene.probes else None
         self.energies()                         # the ledger's initial energy (step 0)
@@ -262,6 +287,29 @@ class Simulation:
     def bonds_broken(self) -> int:
         return self.team.sum(self.failure.bonds_broken) if self.failure else 0
 
+    def bonds_broken_here(self) -> int:
+        """This rank's share of the broken-bond count (a restart gives it all to rank 0)."""
+        return self.failure.bonds_broken if self.failure else 0
+
+    def _set_broken(self, value):
+        if self.failure is not None:
+            self.failure.bonds_broken = int(value)
+
+    def _set_work(self, value):
+        self.external_work = float(value)
+
+    def after_restore(self):
+        """Rebuild, from a restored state, what follows from it: the gas's pair-weight
+        ghosts, the shape tensors, the failure flags' ghosts, damage and damped set
+        (mpipd.output.checkpoint.restore, step 2)."""
+        if self.gas is not None:
+            self.gas.after_restore(self.halo)
+        self.corr.after_restore()
+        if self.failure is not None:
+            self.failure.after_restore()
+            if self.interface is not None:  # retired where bonds broke or families failed
+                self.interface.retire(self.mode)
+
     def failure_counts(self) -> np.ndarray:
         """Failed owned points per mode over all ranks (index = mode, 0 = intact)."""
         if self.failure is None:
@@ -272,39 +320,18 @@ class Simulation:
         return self.team.sum(self.corr.n_spring)
 
     def memory(self) -> dict:
-        """Bytes held by this rank, found by walking every NumPy array the simulation
-        owns (so nothing can be left out): per-bond arrays, the rest, and totals."""
-        seen, arrays = set(), []
-
-        def walk(obj, depth=0):
-            if depth > 8 or id(obj) in seen:
-                return
-            seen.add(id(obj))
-            if isinstance(obj, np.ndarray):
-                if obj.base is None or not isinstance(obj.base, np.ndarray):
-                    arrays.append(obj)
-                return
-            if isinstance(obj, dict):
-                for v in obj.values():
-                    walk(v, depth + 1)
-            elif isinstance(obj, (list, tuple)):
-                for v in obj:
-                    walk(v, depth + 1)
-            elif hasattr(obj, "__dict__") and obj.__class__.__module__.startswith("mpipd"):
-                for v in vars(obj).values():
-                    walk(v, depth + 1)
-
-        walk(self)
-        fam = self.families
-        bond = fam.nbr.nbytes + fam.broken.nbytes
-        point = sum(a.nbytes for a in arrays) - bond
+        """Bytes held by this rank: the State's registered arrays (per-bond, the rest,
+        per owner) and the failure model's reference-position search tree."""
+        m = self.state.memory()
+        bond, point = m["bond_bytes"], m["point_bytes"]
         tree = 0
         if self.failure is not None:                # the reference-position search tree
             tree = self.failure.tree.data.nbytes + self.failure.tree.indices.nbytes
-        nb = max(1, fam.n_bonds)
+        nb = max(1, self.families.n_bonds)
         return {"bond_bytes": bond, "point_bytes": point, "tree_bytes": tree,
                 "bytes_per_bond": bond / nb,
-                "bytes_per_point": (point + tree) / max(1, self.points.n_local)}
+                "bytes_per_point": (point + tree) / max(1, self.points.n_local),
+                "by_owner": m["by_owner"]}
 
     # ------------------------------------------------------------------ time loop
     def run(self, n_steps: int, writer=None, every: int = 0, progress=None,

@@ -3,7 +3,7 @@ counted by walking every array the simulation holds."""
 import pytest
 
 from mpipd.input import scene as sc
-from mpipd.check import BYTES_PER_BOND, BYTES_PER_GAS_POINT, memory_model
+from mpipd.check import BYTES_PER_BOND, BYTES_PER_GAS_POINT, BYTES_PER_UL_POINT, memory_model
 from mpipd.solver import Simulation
 
 
@@ -20,7 +20,8 @@ def test_memory_model_matches_allocation(team, name, over):
     local, owned = memory_model(scene)
     model = local * p.n_local + owned * p.n_owned
     if sim.gas is not None:
-        model += BYTES_PER_GAS_POINT * len(sim.gas.gas_idx)
+        model += (BYTES_PER_GAS_POINT * len(sim.gas.gas_idx)
+                  + BYTES_PER_UL_POINT * len(sim.gas.eligible))
     actual = m["point_bytes"] + m["tree_bytes"]
     assert abs(actual - model) <= 0.01 * model + 4096, (actual, model)
     assert m["bytes_per_bond"] == BYTES_PER_BOND <= 24

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import run_cli
 
-from mpipd.output.writer import checkpoint as ck
+from mpipd.output import checkpoint as ck
 from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 

@@ -23,9 +23,11 @@ Interface (see :class:`mpipd.materials.base.Material`):
     optional rate-dependent tension failure model (Eqs. 37–38, mode 3);
 ``can_fail``
     whether points of this material can fail (then bonds break);
-``exchanged``
-    names of per-point fields the material needs in the halo besides the
-    correspondence data (none for elastic).
+
+A material's history arrays (``new_state``) are registered in the State by the
+correspondence machinery as ``state<material id>/<name>`` (checkpointed; offered
+as output fields by ``materials.base.STATE_OUTPUTS``); none is exchanged in the
+halo (the force data carries what neighbours need).
 """
 from ..input.schema import Registry
 

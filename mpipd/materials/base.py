@@ -25,10 +25,13 @@ def hypoelastic_energy(idx, sigma, J, mode, K, G, out):
         out[i] = J[i] * (p * p / (2.0 * K) + ss / (4.0 * G))
 
 
+#: the output field (``[output] fields``) a material history array is offered as
+STATE_OUTPUTS = {"D": "jh2_damage", "pressure": "pressure", "eps_p": "plastic_strain",
+                 "strain_rate": "strain_rate"}
+
+
 class Material:
     """Mixin for material dataclasses with ``density``, ``bulk_modulus``, ``shear_modulus``."""
-
-    exchanged: tuple[str, ...] = ()
 
     def check(self, path):
         positive(self, path, "density", "bulk_modulus", "shear_modulus")

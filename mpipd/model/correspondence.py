@@ -27,6 +27,8 @@ from ..kernels import energy, integrate, nosb, rotation
 from ..kernels.layout import (CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F,
                              SPRING_K)
 from ..kernels.viscosity import viscosity_data
+from ..materials.base import STATE_OUTPUTS
+from ..state import AUX, LAST, LOCAL, REBUILT
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
 RCOND = 1e-8
@@ -97,6 +99,46 @@ class Correspondence:
         self.n_spring = 0
         # points outside the total-Lagrangian model (the gas): code NOT_TL, never counted
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
+
+    def register(self, state, mode):
+        """This model's arrays in the State (owner "correspondence"), each material
+        group's history as ``state<material id>/<name>`` on every rank (an empty
+        subset where a rank has no point of that material), and the output fields
+        computed from them.  ``mode``: the State's failure flags."""
+        own = "correspondence"
+        add = state.add
+        for name in ("Kinv", "trK", "Fdot", "d", "J", "J_end", "toggled", "gamma", "dil",
+                     "hg_modulus"):
+            add(name, own, getattr(self, name))
+        add("spring", own, self.spring, checkpoint=True, restore=REBUILT)
+        add("F", own, self.F)
+        add("F_old", own, self.F_old, checkpoint=True, restore=LAST)
+        for name in ("R", "V", "sigma", "Jfac"):
+            add(name, own, getattr(self, name), checkpoint=True)
+        add("W", own, self.W, checkpoint=True, output="stress_work")
+        add("fd", own, self.fd, rows=LOCAL, exchanged=True)
+        add("cbb", own, self.cbb, rows=LOCAL)
+        add("not_tl", own, self.not_tl, rows=AUX)
+        if self.viscosity is not None:
+            add("visc_l", own, self.visc_l)
+            add("visc_q", own, self.visc_q)
+        here = {g.mid: g for g in self.groups}
+        for mid, mat in enumerate(self.materials):
+            g = here.get(mid)
+            rows = g.idx if g is not None else np.zeros(0, np.int64)
+            hist = g.state if g is not None else mat.new_state(0)
+            owner = f"material {mid} ({mat.registry_name})"
+            if g is not None:
+                add(f"group{mid}_idx", owner, g.idx, rows=AUX)
+            for key, arr in hist.items():
+                add(f"state{mid}/{key}", owner, arr, rows=rows, checkpoint=True,
+                    output=STATE_OUTPUTS.get(key))
+        state.offer("stress", own, self.cauchy_stress)
+        state.offer("elastic_energy", own, lambda: self.elastic_energy(mode))
+
+    def after_restore(self):
+        """Shape tensors from the restored bonds (restart step 2)."""
+        self.rebuild_shape()
 
     # ---------------------------------------------------------------- steps
     def rebuild_shape(self, which: np.ndarray | None = None, u=None) -> int:

@@ -28,15 +28,20 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.breakage import break_bonds, pairs_from_lists, pd_damage
+from ..state import LOCAL
 
 class Failure:
-    def __init__(self, points, families, halo, corr, damping: float, damp, tl, ledger=None):
+    def __init__(self, points, families, halo, corr, damping: float, damp, tl, mode,
+                 ledger=None):
+        """``damp`` and ``mode`` are the State's damping coefficients and failure
+        flags (mode: local points; written by the materials and the tension model,
+        exchanged and acted on here)."""
         self.points = points
         self.families = families
         self.halo = halo
         self.corr = corr
         n, nl = points.n_owned, points.n_local
-        self.mode = np.zeros(nl, dtype=np.uint8)
+        self.mode = mode
         self.done = np.zeros(nl, dtype=np.uint8)
         self.phi = np.zeros(n)
         self.touched = np.zeros(n, dtype=np.uint8)
@@ -48,6 +53,22 @@ class Failure:
         self.ledger = ledger
         self.bonds_broken = 0
         self.seconds = 0.0                      # wall time spent here (bookkeeping share)
+        self.refresh_damage()
+
+    def register(self, state):
+        """This model's arrays in the State (owner "failure"); the output fields
+        ``damage`` (phi) and ``failure_mode``."""
+        state.add("done", "failure", self.done, rows=LOCAL)
+        state.add("phi", "failure", self.phi, output="damage")
+        state.add("touched", "failure", self.touched)
+        state.offer("failure_mode", "failure",
+                    lambda: self.mode[: self.points.n_owned].astype(np.float64))
+
+    def after_restore(self):
+        """Ghost flags, the failed set, damage and the damped set from the restored
+        mode and bonds (restart step 2); ``bonds_broken`` is a restored scalar."""
+        self.halo.exchange(self.mode)
+        self.done[:] = self.mode != 0
         self.refresh_damage()
 
     def update(self, u) -> int:

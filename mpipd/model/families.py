@@ -24,6 +24,8 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..state import AUX, BOND
+
 
 @dataclass
 class Families:
@@ -34,6 +36,13 @@ class Families:
     @property
     def n_bonds(self) -> int:
         return len(self.nbr)
+
+    def register(self, state):
+        """The CSR arrays in the State (owner "families"; ``broken`` is written by
+        Failure, and saved in checkpoints as gid pairs, not as a field)."""
+        state.add("offsets", "families", self.offsets, rows=AUX)
+        state.add("nbr", "families", self.nbr, rows=BOND)
+        state.add("broken", "families", self.broken, rows=BOND)
 
 
 @numba.njit(cache=True)

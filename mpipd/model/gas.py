@@ -27,8 +27,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .families import _csr_by_row
-from ..kernels.layout import GD_P, GD_V, GD_WIDTH
+from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.ul import gas_gather, gas_update
+from ..state import AUX, LOCAL
 
 #: Verlet skin of the gas families, as a fraction of the gas horizon
 SKIN = 0.2
@@ -73,6 +74,39 @@ class Gas:
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
         self.y = None                            # current positions of the last update
 
+    def register(self, state):
+        """The gas's arrays in the State (owner "gas") under the checkpoint names of
+        before: volume, pressure and last force state (columns of ``gd``), the last
+        step's pair weights and the energy per initial volume; the gas pressure is
+        offered as (its part of) the output field ``pressure``."""
+        own, gd = "gas", self.gd
+        add = state.add
+        add("gd", own, gd, rows=LOCAL, exchanged=True)
+        add("gas_V", own, gd[:, GD_V], rows=LOCAL, checkpoint=True)
+        add("gas_p", own, gd[:, GD_P], rows=LOCAL, checkpoint=True)
+        add("gas_A", own, gd[:, GD_A:GD_V], rows=LOCAL, checkpoint=True)
+        add("gas_Vw", own, self.V_w, rows=LOCAL, checkpoint=True)
+        add("gas_e", own, self.e, rows=self.gas_idx, checkpoint=True)
+        add("gas_Vpw", own, self.V_pw, rows=LOCAL)
+        add("gas_V_ratio", own, self.V_ratio)
+        add("gas_V0", own, self.V0, rows=self.gas_idx)
+        add("gas_t_lit", own, self.t_lit, rows=self.gas_idx)
+        add("gas_is_gas", own, self.is_gas, rows=LOCAL)
+        add("gas_horizon", own, self.gas_horizon, rows=LOCAL)
+        for name in ("eligible", "rows", "gas_idx"):
+            add(f"gas_{name}" if name != "gas_idx" else name, own, getattr(self, name),
+                rows=AUX)
+        add("gas_offsets", own, get=lambda: self.offsets, rows=AUX)
+        add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
+        add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
+        add("gas_y", own, get=lambda: self.y, rows=AUX)
+        state.offer("pressure", own, self.pressure)
+
+    def after_restore(self, halo):
+        """The ghosts' pair weights and the volume ratio from the restored state."""
+        halo.exchange(self.V_w)
+        self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
+
     def search(self, y):
         """Current-configuration families (positions y), each sorted by neighbour gid:
         every pair closer than the larger gas horizon plus the skin.  Skipped while
@@ -106,7 +140,8 @@ class Gas:
         p, m = self.points, self.mat
         y = self.y = p.x + u                    # current positions, kept for gather()
         self.search(y)
-        self.V_pw, self.V_w = self.V_w, self.gd[:, GD_V].copy()
+        self.V_pw[:] = self.V_w                 # in place: the State holds these arrays
+        self.V_w[:] = self.gd[:, GD_V]
         self.n_singular = gas_update(
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,

@@ -54,6 +54,7 @@ import numpy as np
 from ..input.geometry import balls_inside, prisms_inside
 from ..kernels import interface as kern
 from ..kernels.layout import CORRESPONDENCE, KINV_FLAG, KINV_WIDTH
+from ..state import AUX
 
 #: |g_i| dx_i above this is a ghost force (round-off in a uniform lattice is ~1e-14)
 G_TOL = 1e-12
@@ -117,6 +118,13 @@ class InterfaceCorrection:
         out = np.empty(len(idx))
         kern.family_reach(horizon, fam.offsets, fam.nbr, idx, out)
         return out
+
+    def register(self, state):
+        """The corrected points and their data in the State (owner "interface")."""
+        own = "interface"
+        state.add("interface_idx", own, self.idx, rows=AUX)
+        for name in ("q", "active", "fc"):
+            state.add(f"interface_{name}", own, getattr(self, name), rows=self.idx)
 
     def apply(self, fd, F, f):
         """f_i -= P_i g_i at the active corrected points."""

@@ -54,6 +54,7 @@ import numpy as np
 
 from ..kernels import energy as kern
 from ..kernels.layout import INTACT, SPRING_K
+from ..state import AUX, LAST
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
@@ -147,6 +148,26 @@ class Ledger:
         self.jumps = 0.0                 # hourglass + spring energy removed by discontinuities
         self.contact_jumps = 0.0         # contact energy removed (< 0: added) by them
         self.initial = None              # global, set once at step 0
+
+    def register(self, state, interface):
+        """The ledger's per-point memory (owner "ledger") and its accumulated sums
+        (global scalars) in the State, under the checkpoint names of before."""
+        own = "ledger"
+        state.add("ledger_edamp", own, self.edamp, checkpoint=len(self.edamp) > 0)
+        state.add("ledger_fv", own, self.fv)
+        state.add("ledger_fv_old", own, self.fv_old, checkpoint=len(self.fv_old) > 0,
+                  restore=LAST)
+        state.add("ledger_rows", own, self.rows, rows=AUX)
+        if interface is not None:
+            state.add("ledger_fc_old", own, self.fc_old, rows=interface.idx, checkpoint=True,
+                      restore=LAST)
+        else:
+            state.add("ledger_fc_old", own, self.fc_old, rows=AUX)     # empty
+        for name in ("viscous_work", "interface_work", "jumps", "contact_jumps"):
+            state.scalar(f"ledger_{name}", own, (lambda k=name: getattr(self, k)),
+                         (lambda v, k=name: setattr(self, k, float(v))))
+        state.scalar("ledger_initial", own, lambda: self.initial,
+                     lambda v: setattr(self, "initial", float(v)), reduce="same")
 
     def start(self, interface):
         """The forces of the initial state become the 'previous' forces."""

@@ -1,12 +1,17 @@
 """Checkpoint and restart: the complete state, indexed by global id.
 
 A checkpoint holds everything the next step needs that cannot be recomputed
-from it: u, v, a, the unrotated stress, R, V, strain energy, the fallback
-flags, failure modes, every material history array (``points/state<material
-id>/<name>``, on every rank, zeros where a rank has no point of that material), the broken bonds (as
-(gid_i, gid_j) pairs), the gas's volume, pressure and energy, the loads' work,
-the step and the time, and the scene text.  Shape tensors, F, damage phi, the damped set and the force data are
-rebuilt from it deterministically.
+from it: every field of the State registered with ``checkpoint=True``
+(``points/<name>``: u, v, a, the unrotated stress, R, V, stress work, the
+fallback codes, failure modes, F of the last step, the volume factor, every
+material history array as ``points/state<material id>/<name>`` on every rank
+(zeros where a rank has no point of that material), the gas's volume,
+pressure, force state, pair weights and energy, the ledger's per-point memory,
+the running peaks), every registered scalar as an attribute (the loads' work,
+the ledger's sums, the broken-bond count), the broken bonds (as (gid_i, gid_j)
+pairs), the probes' running peaks, the step and the time, and the scene text.
+Shape tensors, F, damage phi, the damped set and the force data are rebuilt
+from it deterministically; :func:`restore` lists the order (mpipd.state).
 
 Because every per-point dataset is indexed by gid and broken bonds by gid
 pairs, a checkpoint written by N ranks restarts on M ranks, and the continued
@@ -25,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..kernels.layout import GD_A, GD_P, GD_V
+from ..state import LAST, REBUILT, STATE
 
 FORMAT = "mpipd-checkpoint-1"
 
@@ -35,47 +40,10 @@ class CheckpointError(ValueError):
 
 
 def _per_point(sim) -> dict:
-    """Owned-point arrays to save: name -> array (first axis = owned points)."""
+    """Owned-point arrays to save: name -> array (first axis = owned points), every
+    checkpointed field of the State (mpipd.state)."""
     n = sim.points.n_owned
-    c = sim.corr
-    out = {"u": sim.u[:n], "v": sim.v[:n], "a": sim.a, "sigma": c.sigma, "R": c.R, "V": c.V,
-           "W": c.W, "spring": c.spring, "mode": sim.mode[:n],
-           # F of the last step, over the families after that step's breakage (the
-           # next rotation increment needs it as it was, not recomputed), and the
-           # volume factor that keeps J continuous across those rebuilds
-           "F_old": c.F_old, "Jfac": c.Jfac}
-    led = sim.ledger                              # the ledger's per-point memory
-    if len(led.edamp):
-        out["ledger_edamp"] = led.edamp
-    if len(led.fv_old):
-        out["ledger_fv_old"] = led.fv_old
-    if sim.interface is not None:
-        fc = np.zeros((n, 3))
-        fc[sim.interface.idx] = led.fc_old
-        out["ledger_fc_old"] = fc
-    for key, arr in sim.peaks.arrays.items():
-        if len(arr):
-            out[key] = arr
-    # material history by material id, the same names on every rank (the datasets are
-    # created collectively): a material with no points here writes zeros
-    here = {g.mid: g for g in c.groups}
-    for mid, mat in enumerate(c.materials):
-        g = here.get(mid)
-        for key, arr in (g.state if g is not None else mat.new_state(0)).items():
-            full = np.zeros((n,) + arr.shape[1:], arr.dtype)
-            if g is not None:
-                full[g.idx] = arr
-            out[f"state{mid}/{key}"] = full
-    if sim.gas is not None:                       # volume, pressure, energy of the gas
-        gas = sim.gas
-        out["gas_V"] = gas.gd[:n, GD_V]
-        out["gas_p"] = gas.gd[:n, GD_P]
-        out["gas_A"] = gas.gd[:n, GD_A:GD_V]             # the last force (its work ends next step)
-        out["gas_Vw"] = gas.V_w[:n]               # the last step's pair weights
-        e = np.zeros(n)
-        e[gas.gas_idx] = gas.e
-        out["gas_e"] = e
-    return out
+    return {f.name: f.owned_values(n) for f in sim.state.checkpointed()}
 
 
 def _broken_pairs(sim) -> np.ndarray:
@@ -127,15 +95,8 @@ def _write(sim, tmp, scene_text, overrides, run_id):
         a["t"] = sim.t
         a["n_points"] = N
         a["ranks"] = team.size
-        a["external_work"] = team.sum(sim.external_work)
-        led = sim.ledger
-        for key, v in (("ledger_viscous_work", led.viscous_work),
-                       ("ledger_interface_work", led.interface_work),
-                       ("ledger_jumps", led.jumps),
-                       ("ledger_contact_jumps", led.contact_jumps)):
-            a[key] = team.sum(v)
-        a["ledger_initial"] = led.initial
-        a["bonds_broken"] = sim.bonds_broken()
+        for s in sim.state.scalars.values():    # loads' work, ledger sums, broken bonds
+            a[s.name] = team.sum(s.get()) if s.reduce == "sum" else s.get()
         if sim.probes is not None:                # the running peaks, whole run
             a["probe_peaks"] = json.dumps(sim.probes.peaks())
         for name, arr in _per_point(sim).items():
@@ -259,13 +220,12 @@ def restore(sim, path) -> None:
     """Load a checkpoint into a freshly built Simulation of the same scene."""
     import h5py
     team = sim.team
-    n = sim.points.n_owned
     g0, g1 = sim.gid_range
     with h5py.File(path, "r", driver="mpio", comm=team.comm) as f:
         if f.attrs.get("format") != FORMAT or int(f.attrs["n_points"]) != sim.n_global:
             raise CheckpointError(f"{path}: checkpoint does not match this scene")
         data = {}
-        for name, arr in _per_point(sim).items():
+        for name in (fld.name for fld in sim.state.checkpointed()):
             if f"points/{name}" not in f:
                 raise CheckpointError(f"{path}: checkpoint lacks points/{name}")
             data[name] = f[f"points/{name}"][g0:g1]
@@ -274,25 +234,23 @@ def restore(sim, path) -> None:
         lo, hi = np.searchsorted(gi, g0, "left"), np.searchsorted(gi, g1, "left")
         mine = broken[lo:hi] if hi > lo else np.empty((0, 2), np.int64)
         step, t = int(f.attrs["step"]), float(f.attrs["t"])
-        work = float(f.attrs["external_work"])
-        ledger = {k: float(f.attrs[k]) for k in ("ledger_viscous_work", "ledger_interface_work",
-                                                 "ledger_jumps", "ledger_contact_jumps",
-                                                 "ledger_initial")}
-        n_broken = int(f.attrs["bonds_broken"])
+        scalars = {}
+        for name in sim.state.scalars:
+            if name not in f.attrs:
+                raise CheckpointError(f"{path}: checkpoint lacks attribute {name}")
+            v = f.attrs[name]
+            scalars[name] = int(v) if np.issubdtype(np.asarray(v).dtype, np.integer) else float(v)
         probe_peaks = json.loads(str(f.attrs["probe_peaks"])) if "probe_peaks" in f.attrs else {}
     bad = [name for name, arr in data.items()
            if arr.dtype.kind == "f" and not np.all(np.isfinite(arr))]
     bad = sorted(set().union(*team.gather(set(bad))))
-    if bad or not all(np.isfinite(v) for v in (t, work, *ledger.values())):
+    if bad or not all(np.isfinite(v) for v in (t, *scalars.values())):
         raise CheckpointError(f"{path}: non-finite values in " + (", ".join(bad) or "attributes")
                               + " (a corrupted checkpoint, or one written by a blow-up)")
-    c = sim.corr
-    sim.u[:n], sim.v[:n], sim.a[:] = data["u"], data["v"], data["a"]
-    c.sigma[:], c.R[:], c.V[:], c.W[:] = data["sigma"], data["R"], data["V"], data["W"]
-    sim.mode[:n] = data["mode"]
-    for g in c.groups:
-        for key, arr in g.state.items():
-            arr[:] = data[f"state{g.mid}/{key}"][g.idx]
+    st = sim.state
+    n = sim.points.n_owned
+    for fld in st.checkpointed(STATE):                  # 1. the state
+        fld.load(data[fld.name])
     # broken bonds by gid pair
     fam, gid = sim.families, sim.points.gid
     if len(mine):
@@ -300,46 +258,15 @@ def restore(sim, path) -> None:
         key = gid[rows] * sim.n_global + gid[fam.nbr]
         want = np.sort(mine[:, 0] * sim.n_global + mine[:, 1])
         fam.broken[:] = np.isin(key, want).astype(np.uint8)
-    if sim.gas is not None:
-        gas = sim.gas
-        gas.gd[:n, GD_V], gas.gd[:n, GD_P] = data["gas_V"], data["gas_p"]
-        gas.gd[:n, GD_A:GD_V] = data["gas_A"]
-        gas.V_w[:n] = data["gas_Vw"]
-        sim.halo.exchange(gas.V_w)
-        gas.e[:] = data["gas_e"][gas.gas_idx]
-        gas.V_ratio[gas.gas_idx] = gas.V_w[gas.gas_idx] / gas.V0
     sim.step_count, sim.t = step, t
-    sim.external_work = work if team.root else 0.0
-    # rebuild what follows from the state
-    c.rebuild_shape()
-    c.spring[:] = data["spring"]
-    if sim.failure is not None:
-        fl = sim.failure
-        fl.bonds_broken = n_broken if team.root else 0      # a global count, held once
-        sim.halo.exchange(fl.mode)
-        fl.done[:] = fl.mode != 0
-        fl.refresh_damage()
-        if sim.interface is not None:       # retired where bonds broke or families failed
-            sim.interface.retire(sim.mode)
-    led = sim.ledger
-    own = team.root                                 # global sums, held once
-    led.viscous_work = ledger["ledger_viscous_work"] if own else 0.0
-    led.interface_work = ledger["ledger_interface_work"] if own else 0.0
-    led.jumps = ledger["ledger_jumps"] if own else 0.0
-    led.contact_jumps = ledger["ledger_contact_jumps"] if own else 0.0
-    led.initial = ledger["ledger_initial"]
-    if len(led.edamp):
-        led.edamp[:] = data["ledger_edamp"]
-    for key, arr in sim.peaks.arrays.items():
-        if len(arr):
-            arr[:] = data[key]
-    c.Jfac[:] = data["Jfac"]
+    for name, s in st.scalars.items():                  # global sums: held once, on rank 0
+        v = scalars[name]
+        s.set(v if s.reduce == "same" or team.root else type(v)(0))
+    sim.after_restore()                                 # 2. what follows from it
+    for fld in st.checkpointed(REBUILT):                # 3. saved over the rebuild
+        fld.load(data[fld.name])
     if sim.probes is not None:
         sim.probes.restore_peaks(probe_peaks)
-    sim.initialize()
-    sim.a[:] = data["a"]
-    c.F_old[:] = data["F_old"]
-    if len(led.fv_old):
-        led.fv_old[:] = data["ledger_fv_old"]
-    if sim.interface is not None:
-        led.fc_old[:] = data["ledger_fc_old"][sim.interface.idx]
+    sim.initialize()                                    # 4. F and forces
+    for fld in st.checkpointed(LAST):                   # 5. the last step's values
+        fld.load(data[fld.name])

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..kernels.energy import update_peaks
 from ..kernels.layout import GD_P
+from ..state import AUX
 
 NAMES = ("peak_pressure", "peak_sigma_rr", "peak_speed")
 
@@ -32,6 +33,14 @@ class Peaks:
         self.arrays = {k: np.zeros(size) for k in NAMES}
         self._empty = np.zeros(0, np.int64)
         self._nogas = np.zeros(0)
+
+    def register(self, state):
+        """The peak arrays in the State (owner "peaks"), checkpointed and offered as
+        output fields when the scene asks for them."""
+        for key, arr in self.arrays.items():
+            state.add(key, "peaks", arr, checkpoint=self.on, output=key)
+        state.add("peaks_empty", "peaks", self._empty, rows=AUX)
+        state.add("peaks_nogas", "peaks", self._nogas, rows=AUX)
 
     def sample(self, sim):
         if not self.on:

@@ -37,7 +37,6 @@ import numpy as np
 from .. import __version__
 from ..kernels.linalg import VOIGT
 from ..model.ledger import TERMS
-from .peaks import NAMES as PEAKS
 from ..input.scene import OUTPUT_FIELDS
 
 
@@ -56,36 +55,10 @@ def n_frames(n_steps: int, every: int) -> int:
     return n_steps // every + 1 + (1 if n_steps % every else 0)
 
 
-def _state(key):
-    """A material state array (e.g. JH2's D) as a field over all owned points (0 elsewhere)."""
-    def get(sim):
-        out = np.zeros(sim.points.n_owned)
-        for g in sim.corr.groups:
-            if key in g.state:
-                out[g.idx] = g.state[key]
-        return out
-    return get
-
-
-#: how each output field is read from a Simulation (owned points, gid order)
-FIELD_VALUES = {
-    "u": lambda sim: sim.u[:sim.points.n_owned],
-    "v": lambda sim: sim.v[:sim.points.n_owned],
-    "stress": lambda sim: sim.corr.cauchy_stress(),
-    "stress_work": lambda sim: sim.corr.W,
-    "elastic_energy": lambda sim: sim.corr.elastic_energy(sim.mode),
-    **{k: (lambda sim, k=k: sim.peaks.arrays[k]) for k in PEAKS},
-    "damage": lambda sim: sim.failure.phi,
-    "failure_mode": lambda sim: sim.failure.mode[:sim.points.n_owned].astype(np.float64),
-    "jh2_damage": _state("D"),
-    "pressure": lambda sim: _state("pressure")(sim) + (sim.gas.pressure() if sim.gas else 0.0),
-    "plastic_strain": _state("eps_p"),
-    "strain_rate": _state("strain_rate"),
-}
-
-
 def field_values(sim, name: str) -> np.ndarray:
-    return FIELD_VALUES[name](sim)
+    """Output field ``name`` over the owned points (gid order), as the State's
+    owners offer it (mpipd.state.State.output)."""
+    return sim.state.output(name, OUTPUT_FIELDS[name][0])
 
 
 #: bytes of one chunk of a frame dataset (a frame is split into chunks of about this size)

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..input.geometry import LayerTable, fill_layers
 from ..kernels.influence import CODES as INFLUENCE
+from ..state import LOCAL
 
 
 class DecompositionError(ValueError):
@@ -174,6 +175,11 @@ class Points:
     @property
     def n_local(self) -> int:
         return len(self.gid)
+
+    def register(self, state):
+        """The reference geometry in the State (owner "points"; never written)."""
+        for name in ("x", "gid", "part", "material", "volume", "horizon", "dx", "influence"):
+            state.add(name, "points", getattr(self, name), rows=LOCAL)
 
 
 def local_points(scene, slabs: Slabs, r: int) -> Points:
