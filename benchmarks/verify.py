@@ -2,9 +2,9 @@
 
     python benchmarks/verify.py [--quick] [--out runs/verify] [--problems a,b] [--ranks 1,2]
 
-Runs every problem of ``benchmarks/verify_case.py`` at its resolutions, on 1 and
-on 2 ranks (``mpirun -n R``; a material-point problem only on 1), and writes to
-``--out``:
+Runs every problem of ``benchmarks/problems/`` (one module a problem, run by
+``benchmarks/verify_case.py``) at its resolutions, on 1 and on 2 ranks
+(``mpirun -n R``; a material-point problem only on 1), and writes to ``--out``:
 
 * ``table.md``, ``table.csv``, ``results.json``: problem, resolution (dx, or the
   strain or time step), points, ranks, wall seconds, error measure, observed
