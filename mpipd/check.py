@@ -96,7 +96,10 @@ def bulk_family(dx: float, horizon: float) -> np.ndarray:
 
 
 def stable_dt(part, material) -> tuple[float, float]:
-    """(Silling–Askari dt, dx / c_p) for a bulk point of ``part``."""
+    """(Silling–Askari dt, dx / c_p) for a bulk point of ``part``:
+    dt_c = sqrt(2 rho / sum_j V_j c / |xi_j|), c = 18 K / (pi delta^4), V_j = dx^3 over
+    the bulk family, and c_p = ``material.p_wave_speed`` (sqrt((K + 4G/3) / rho); the
+    detonation speed of a JWL explosive)."""
     r = bulk_family(part.dx, part.horizon)
     c = 18.0 * material.bulk_modulus / (math.pi * part.horizon ** 4)
     dt_sa = math.sqrt(2.0 * material.density / np.sum(part.dx ** 3 * c / r))
@@ -104,7 +107,9 @@ def stable_dt(part, material) -> tuple[float, float]:
 
 
 def critical_dt(scene) -> float:
-    """The stable-step estimate ``mpipd run`` holds dt to: the smallest over parts."""
+    """The stable-step estimate ``mpipd run`` holds dt to (and ``mpipd check`` reports,
+    benchmarks.verify_case scales): dt_max = min over parts of min(dt_c, dx / c_p)
+    (:func:`stable_dt`)."""
     return min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
 
 

@@ -144,7 +144,7 @@ def _run(args, team, signals=None) -> int:
     from .input import scene as sc
     from .parallel.decomp import DecompositionError
     from .input.geometry import check_parts
-    from .check import stable_dt
+    from .check import critical_dt
     from .input.schema import SceneError
     from .solver import Simulation
 
@@ -180,7 +180,7 @@ def _run(args, team, signals=None) -> int:
         else:
             _on_root(team, rundir.check_new_run, out, args.overwrite)
         check_parts(scene.parts)             # geometry first: empty, oversized, overlapping
-        dt_stable = min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
+        dt_stable = critical_dt(scene)
         if scene.time.dt > dt_stable and not args.force:
             raise UsageError(f"time.dt = {scene.time.dt:.4e} s exceeds the stable estimate "
                              f"{dt_stable:.4e} s (see `mpipd check`); use --force to run anyway")

@@ -26,6 +26,7 @@ import sys
 
 import numpy as np
 
+from .fits import peak_time
 from .reader import Run, RunFileError
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -36,7 +37,6 @@ class UsageError(Exception):
 
 
 def summary(run: Run, comm) -> list[str]:
-    from mpi4py import MPI
     v = run.field("v") if run.has_field("v") else None
     t = run.time
     lines = [f"points {run.n_points}  frames {run.frames}  t {t[0]:.4e}..{t[-1]:.4e} s"]
@@ -51,15 +51,13 @@ def summary(run: Run, comm) -> list[str]:
                      "(relative)")
     if v is not None:
         local = np.sqrt((v ** 2).sum(axis=2)).max(axis=1) if v.shape[1] else np.zeros(run.frames)
-        peak = np.empty_like(local)
-        comm.Allreduce(local, peak, op=MPI.MAX)
+        peak = run.max_array(local)
         lines.append("peak |v| per frame (m/s): " + " ".join(f"{p:.4g}" for p in peak))
     return lines
 
 
 def station_means(run: Run, comm, axis: int, comp: int, stations, tol) -> np.ndarray:
     """(frames, stations) mean of v[..., comp] over points within tol of each station."""
-    from mpi4py import MPI
     x = run.geometry("x")[:, axis]
     v = run.field("v")[:, :, comp]
     sums = np.zeros((run.frames, len(stations)))
@@ -67,24 +65,23 @@ def station_means(run: Run, comm, axis: int, comp: int, stations, tol) -> np.nda
     for k, s in enumerate(stations):
         m = np.abs(x - s) <= tol
         sums[:, k] = run.level_total(run.per_level(np.where(m[:, None], v.T, 0.0)))
-        counts[k] = comm.allreduce(int(m.sum()), op=MPI.SUM)
+        counts[k] = run.sum_int(int(m.sum()))
     if np.any(counts == 0):
         raise ValueError(f"no points near station(s) {[s for s, c in zip(stations, counts) if not c]}")
     return sums / counts
 
 
-def peak_time(t: np.ndarray, y: np.ndarray) -> float:
-    k = int(np.argmax(y))
-    if k == 0 or k == len(y) - 1:
-        raise ValueError("the peak is at the first or last frame: the run is too short "
-                         "or the station too far")
-    y0, y1, y2 = y[k - 1:k + 2]
-    return float(t[k] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2) * (t[k + 1] - t[k]))
-
-
 def wave_speed(run: Run, comm, axis: str, component: str, stations, tol) -> tuple[float, list]:
+    """Slope of the stations against the peak times of their means (:func:`fits.peak_time`);
+    a peak at the first or last frame is refused (its time is not known)."""
     means = station_means(run, comm, AXES[axis], AXES[component], stations, tol)
-    arrivals = [peak_time(run.time, means[:, k]) for k in range(len(stations))]
+    arrivals = []
+    for k in range(len(stations)):
+        t, _, interior = peak_time(run.time, means[:, k])
+        if not interior:
+            raise ValueError("the peak is at the first or last frame: the run is too short "
+                             "or the station too far")
+        arrivals.append(t)
     speed = float(np.polyfit(arrivals, stations, 1)[0])
     return speed, arrivals
 
@@ -93,12 +90,12 @@ def section(run: Run, comm, field: str, frame: int, z: float | None):
     """x, y and field values of the points on the z level nearest ``z`` — gathered to
     rank 0 (one section, not the model)."""
     x = run.geometry("x")
-    zmin = comm.allreduce(x[:, 2].min() if len(x) else np.inf, op=_mpi_op("MIN"))
-    zmax = comm.allreduce(x[:, 2].max() if len(x) else -np.inf, op=_mpi_op("MAX"))
+    zmin = run.min(x[:, 2].min() if len(x) else np.inf)
+    zmax = run.max(x[:, 2].max() if len(x) else -np.inf)
     target = 0.5 * (zmin + zmax) if z is None else z
     levels = np.unique(x[:, 2])
     near = levels[np.argmin(np.abs(levels - target))] if len(levels) else np.inf
-    dist = comm.allreduce(abs(near - target), op=_mpi_op("MIN"))
+    dist = run.min(abs(near - target))
     cands = comm.allgather(near if abs(near - target) == dist else np.inf)
     zlev = min(cands)
     sel = x[:, 2] == zlev
@@ -110,11 +107,6 @@ def section(run: Run, comm, field: str, frame: int, z: float | None):
         return None
     xs, ys, vs = (np.concatenate([p[k] for p in parts]) for k in range(3))
     return xs, ys, vs, zlev
-
-
-def _mpi_op(name):
-    from mpi4py import MPI
-    return getattr(MPI, name)
 
 
 def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[str]:

@@ -44,8 +44,14 @@ def power_law(d, y) -> dict:
 
 
 def peak_time(t, y) -> tuple[float, float, bool]:
-    """(time, value, interior) of the largest sample of ``y``; the time is refined by
-    the parabola through the neighbours when the peak is not at either end."""
+    """(time, value, interior) of the largest sample y_k of ``y`` (NaNs ignored).
+
+    Inside the record (0 < k < n - 1, ``interior`` True) the time is the vertex of the
+    parabola through (t_k-1, y_k-1), (t_k, y_k), (t_k+1, y_k+1):
+        t = t_k + s h,  s = (y_k-1 - y_k+1) / (2 (y_k-1 - 2 y_k + y_k+1)),
+    s clamped to [-1/2, 1/2] (0 if the denominator is 0) and h the step on the
+    side of the shift (t_k+1 - t_k for s >= 0, t_k - t_k-1 otherwise).  At the first or
+    last sample, (t_k, y_k, False): the peak may lie outside the record."""
     t, y = np.asarray(t, float), np.asarray(y, float)
     k = int(np.nanargmax(y))
     if k == 0 or k == len(y) - 1:

@@ -26,7 +26,7 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
   law PPV = K d^-beta.
 * Pressure–stress paths (Fig. 15): (p, s) at P1–P3 against the JH2 strength
   recorded at the point (sigma_y at its p*, edot*, D; Eqs. 21–23) and the intact
-  and fractured envelopes at edot* = 1:
+  and fractured envelopes at edot* = 1 (:func:`mpipd.materials.jh2.strength_envelope`):
       sigma_i = sigma_HEL A (p* + T*)^N,  sigma_f = sigma_HEL B p*^M.
   A point has yielded once s >= 0.99 sigma_y with sigma_y > 0 (paper: P1 yields at
   p ~ 200 MPa, P2 at s ~ 150 MPa, P3 never reaches its strength).
@@ -34,6 +34,8 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
 from __future__ import annotations
 
 import numpy as np
+
+from mpipd.materials.jh2 import rate_factor, strength_envelope
 
 from . import arrivals, fits
 from .model import zone_of
@@ -229,13 +231,14 @@ def ppv(probes) -> dict:
     return out
 
 
-def jh2_envelope(jh2, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Intact and fractured JH2 strength (Pa) at pressures p (Pa), edot* = 1."""
-    ps = np.asarray(p, float) / jh2.p_HEL
-    ts = jh2.T / jh2.p_HEL
-    si = jh2.sigma_hel * jh2.A * np.clip(ps + ts, 0, None) ** jh2.N
-    sf = jh2.sigma_hel * jh2.B * np.clip(ps, 0, None) ** jh2.M
-    return si, sf
+def jh2_envelope(jh2, p: np.ndarray, strain_rate=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Intact and fractured JH2 strength (Pa) at pressures p (Pa) and strain rate edot
+    (1/s; the default 0 is edot* = 1): sigma_HEL (sigma_i*, sigma_f*) of
+    :func:`mpipd.materials.jh2.strength_envelope` at p* = p / p_HEL, T* = T / p_HEL."""
+    rate = rate_factor(strain_rate, jh2.C, jh2.rate_norm)
+    si, sf = strength_envelope(np.asarray(p, float) / jh2.p_HEL, rate, jh2.A, jh2.N,
+                               jh2.B, jh2.M, jh2.T / jh2.p_HEL)
+    return jh2.sigma_hel * si, jh2.sigma_hel * sf
 
 
 def pressure_stress(probes) -> dict:

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mpipd.parallel.team import Team
+
 REQUIRED = ("geometry/x", "geometry/volume", "geometry/part", "geometry/material", "time")
 
 
@@ -34,6 +36,7 @@ class Run:
     def __init__(self, path, comm):
         import h5py
         self.comm = comm
+        self.team = Team(comm)
         self.path = str(path)
         self._geo = {}
         try:
@@ -78,7 +81,6 @@ class Run:
 
     def _partition(self):
         """Cut the naive slices ``N r / n`` forward to the next start of a z level."""
-        from mpi4py import MPI
         r, n, N = self.comm.Get_rank(), self.comm.Get_size(), self.n_points
         lo0, hi0 = N * r // n, N * (r + 1) // n
         a = max(lo0 - 1, 0)
@@ -95,7 +97,7 @@ class Run:
         self.levels = (np.concatenate(([0], np.flatnonzero(np.diff(zl) != 0) + 1))
                        if len(zl) else np.zeros(0, dtype=np.int64))
         self.level_z = zl[self.levels] if len(zl) else np.zeros(0)
-        self.n_levels = self.comm.allreduce(len(self.levels), op=MPI.SUM)
+        self.n_levels = self.sum_int(len(self.levels))
 
     # ------------------------------------------------------------------ reads
     def geometry(self, name: str) -> np.ndarray:
@@ -166,30 +168,24 @@ class Run:
         floating-point result on any number of ranks."""
         return self.all_levels(local).sum(axis=0)
 
+    # Reductions over the reading ranks: mpipd.parallel.team.Team's (one implementation
+    # for the solver and the postprocessor); a number, or a NumPy array elementwise.
     def max(self, x):
-        from mpi4py import MPI
-        return self.comm.allreduce(x, op=MPI.MAX)
+        return self.team.max(x)
 
     def min(self, x):
-        from mpi4py import MPI
-        return self.comm.allreduce(x, op=MPI.MIN)
+        return self.team.min(x)
 
     def sum_int(self, x):
-        from mpi4py import MPI
-        return self.comm.allreduce(x, op=MPI.SUM)
+        """Sum over ranks of an integer (exact in any order)."""
+        return self.team.sum(x)
 
     def max_array(self, x: np.ndarray) -> np.ndarray:
-        from mpi4py import MPI
-        out = np.empty_like(x)
-        self.comm.Allreduce(np.ascontiguousarray(x), out, op=MPI.MAX)
-        return out
+        return self.team.max(np.asarray(x))
 
     def sum_array(self, x: np.ndarray) -> np.ndarray:
         """Elementwise sum over ranks of an integer array (exact in any order)."""
-        from mpi4py import MPI
-        out = np.empty_like(x)
-        self.comm.Allreduce(np.ascontiguousarray(x), out, op=MPI.SUM)
-        return out
+        return self.team.sum(np.asarray(x))
 
     @property
     def root(self) -> bool:

@@ -201,3 +201,36 @@ def test_eos_energy_is_the_integral_of_the_pressure():
                      epsabs=0, epsrel=1e-13)[0]
         assert want > 0
         assert eos_energy(mu, K1, K2, K3) == pytest.approx(want, rel=1e-11)
+
+
+def test_rate_factor_and_strength_envelope_match_eqs_21_23():
+    """The NumPy forms (used by the postprocessor's envelopes) against Eqs. 21–23 written
+    out here and hand values of Table 1 granite at p = 200 MPa, edot = 1000 /s:
+    p* = 200/3700, T* = 54/3700, 1 + 0.005 ln 1000 = 1.03454,
+    sigma_i = 1.2 GPa * 1.9 (p* + T*)^0.62 * 1.03454 = 448.12 MPa,
+    sigma_f = 1.2 GPa * 0.25 p*^0.62 * 1.03454 = 50.84 MPa."""
+    from mpipd.materials.jh2 import jh2_strength, rate_factor, strength_envelope
+    A, N, B, Mx = M.A, M.N, M.B, M.M
+    r = rate_factor(1000.0, M.C, M.rate_norm)
+    assert r == pytest.approx(1.0 + 0.005 * math.log(1000.0), rel=1e-15)
+    assert r == pytest.approx(1.03454, abs=1e-5)
+    # edot* <= 1 is clamped to ln edot* = 0, for numbers and arrays alike
+    np.testing.assert_array_equal(rate_factor(np.array([0.0, 0.5, 1.0]), M.C, 1.0), 1.0)
+    assert rate_factor(1000.0, M.C, 1000.0) == 1.0
+    si, sf = strength_envelope(200e6 / PHEL, r, A, N, B, Mx, TS)
+    assert SHEL * si == pytest.approx(448.12e6, rel=1e-5)
+    assert SHEL * sf == pytest.approx(50.84e6, rel=1e-4)
+    for D in (0.0, 0.3, 1.0):
+        assert SHEL * (si - D * (si - sf)) == pytest.approx(strength(200e6, 1000.0, D),
+                                                            rel=1e-14)
+    # zero outside the envelopes' domains: sigma_i for p* + T* <= 0, sigma_f for p* <= 0
+    ps = np.array([-2 * TS, -TS, -0.5 * TS, 0.0, 0.01, 0.5])
+    si, sf = strength_envelope(ps, 1.0, A, N, B, Mx, TS)
+    np.testing.assert_array_equal(si[:2], 0.0)
+    np.testing.assert_array_equal(sf[:4], 0.0)
+    assert np.all(si[2:] > 0) and np.all(sf[4:] > 0)
+    # the kernel's sigma_y* (Eq. 21) from the same envelopes, to round-off
+    for D in (0.0, 0.3, 1.0):
+        want = [jh2_strength(x, 1.2, D, A, N, B, Mx, TS) for x in ps]
+        si, sf = strength_envelope(ps, 1.2, A, N, B, Mx, TS)
+        np.testing.assert_allclose(si - D * (si - sf), want, rtol=1e-14, atol=1e-300)

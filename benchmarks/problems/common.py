@@ -21,8 +21,8 @@ def build_scene(d):
 
 def stable_step(scene) -> float:
     """The step `mpipd run` accepts at most (the Silling-Askari / CFL estimate)."""
-    from mpipd.check import stable_dt
-    return min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
+    from mpipd.check import critical_dt
+    return critical_dt(scene)
 
 
 class Timer:

@@ -104,6 +104,28 @@ def jh2_strength(ps, rate, D, A, N, B, M, T_star):
     return si - D * (si - sf)
 
 
+def rate_factor(edot, C, rate_norm):
+    """The rate term of Eqs. 21-23 for numbers or NumPy arrays (NumPy, not a kernel):
+    1 + C ln edot*, edot* = edot / edot_n, clamped to 1 for edot* <= 1 (ln edot* >= 0)."""
+    es = np.asarray(edot, dtype=float) / rate_norm
+    return np.where(es > 1.0, 1.0 + C * np.log(np.maximum(es, 1.0)), 1.0)
+
+
+def strength_envelope(ps, rate, A, N, B, M, T_star):
+    """Normalised intact and fractured strengths (sigma_i*, sigma_f*) of Eqs. 21 and 23
+    at p* = ``ps`` (numbers or NumPy arrays; NumPy, not a kernel), rate = 1 + C ln edot*
+    (:func:`rate_factor`):
+        sigma_i* = A (p* + T*)^N rate   (0 where p* + T* <= 0),
+        sigma_f* = B (p*)^M rate        (0 where p* <= 0);
+    the yield strength is sigma_y = sigma_HEL [sigma_i* - D (sigma_i* - sigma_f*)]
+    (:func:`jh2_strength`, the kernel's)."""
+    ps = np.asarray(ps, dtype=float)
+    x = ps + T_star
+    si = np.where(x > 0.0, A * np.maximum(x, 0.0) ** N * rate, 0.0)
+    sf = np.where(ps > 0.0, B * np.maximum(ps, 0.0) ** M * rate, 0.0)
+    return si, sf
+
+
 @numba.njit(cache=True)
 def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
                G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T, beta, D1, D2, rate_norm):

@@ -25,19 +25,26 @@ class Team:
         from mpi4py import MPI
         return getattr(MPI, name)
 
-    def sum(self, x):
-        """Global sum of a number or of a NumPy array (elementwise)."""
+    def _reduce(self, x, name):
+        """``name`` (SUM, MAX, MIN) over the ranks of a number (a Python object reduction)
+        or of a NumPy array (elementwise, into an array of its dtype)."""
         if np.isscalar(x):
-            return self.comm.allreduce(x, op=self._op("SUM"))
+            return self.comm.allreduce(x, op=self._op(name))
         out = np.empty_like(x)
-        self.comm.Allreduce(np.ascontiguousarray(x), out, op=self._op("SUM"))
+        self.comm.Allreduce(np.ascontiguousarray(x), out, op=self._op(name))
         return out
 
+    def sum(self, x):
+        """Global sum of a number or of a NumPy array (elementwise)."""
+        return self._reduce(x, "SUM")
+
     def max(self, x):
-        return self.comm.allreduce(x, op=self._op("MAX"))
+        """Global maximum of a number or of a NumPy array (elementwise)."""
+        return self._reduce(x, "MAX")
 
     def min(self, x):
-        return self.comm.allreduce(x, op=self._op("MIN"))
+        """Global minimum of a number or of a NumPy array (elementwise)."""
+        return self._reduce(x, "MIN")
 
     def gather(self, x):
         """Small per-rank values to every rank (a list indexed by rank)."""
