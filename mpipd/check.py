@@ -60,7 +60,7 @@ BYTES_PER_UL_POINT = 16         # the UL search lists (eligible, rows): the gas 
 
 
 def is_gas_part(scene, part) -> bool:
-    return bool(getattr(scene.materials[part.material], "is_gas", False))
+    return part.material in scene.gas_materials
 
 
 def memory_model(scene) -> tuple[int, int]:

@@ -52,8 +52,7 @@ class Simulation:
         self.team = team
         self.dt = scene.time.dt
         table = LayerTable.from_parts(scene.parts, scene.material_ids)
-        gas_parts = [k for k, q in enumerate(scene.parts)
-                     if getattr(scene.materials[q.material], "is_gas", False)]
+        gas_parts = scene.gas_parts
         # the gas and the solids it acts on are held whole on every rank
         self.slabs = decompose(table, team.size, halo_width(scene), replicated_parts(scene))
         self.n_global = table.n_points
@@ -115,7 +114,7 @@ class Simulation:
         if self.failure is not None:
             self.failure.register(st)
         # the explosive gas exists only if the scene has one
-        self.gas = Gas(self) if gas_parts else None
+        self.gas = Gas(scene, p, team) if gas_parts else None
         if self.gas is not None:
             self.gas.register(st)
             self.damp[self.gas.gas_idx] = self.gas.mat.damping
@@ -134,7 +133,8 @@ class Simulation:
         self.peaks = Peaks(self, scene.output)
         self.peaks.register(st)
         self.initialize()
-        self.probes = Probes(self, scene.probes) if scene.probes else None
+        self.probes = (Probes(scene.probes, scene, p, team, self.corr, self.v, self.mode)
+                       if scene.probes else None)
         self.energies()                         # the ledger's initial energy (step 0)
 
     def initialize(self):
@@ -340,7 +340,7 @@ class Simulation:
         writing a frame every ``every`` steps and at the last step, and
         checkpointing as ``checkpointer`` says.  Returns the loop's wall time."""
         if self.probes is not None and self.step_count == 0:
-            self.probes.sample()
+            self.probes.sample(self.step_count, self.t)
         if writer is not None and self.step_count == 0:
             writer.frame(self)
         t0 = _time.perf_counter()
@@ -348,7 +348,7 @@ class Simulation:
         while self.step_count < n_steps:
             self.step()
             if self.probes is not None:
-                self.probes.sample()
+                self.probes.sample(self.step_count, self.t)
             last = self.step_count == n_steps
             frame = writer is not None and every and (self.step_count % every == 0 or last)
             if frame or self.step_count % FINITE_CHECK_EVERY == 0:

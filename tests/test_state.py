@@ -82,7 +82,7 @@ def test_every_array_is_registered(team, name, over):
     for _ in range(3):
         sim.step()
         if sim.probes is not None:
-            sim.probes.sample()
+            sim.probes.sample(sim.step_count, sim.t)
     found = reachable_arrays(sim)
     reg = registered_bases(sim.state)
     missing = sorted(path for k, path in found.items()

@@ -281,11 +281,11 @@ class Scene:
                      f"no material {p.material!r} (defined: {', '.join(self.materials)})")
             if p.name in names:
                 fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
-            if p.influence != "quadratic" and getattr(self.materials[p.material], "is_gas", False):
+            if p.influence != "quadratic" and p.material in self.gas_materials:
                 fail(f"parts[{i}].influence", "the explosive gas (updated-Lagrangian) always "
                                               "uses the quadratic influence function")
             names.add(p.name)
-        gas = [m for m, mat in self.materials.items() if getattr(mat, "is_gas", False)]
+        gas = self.gas_materials
         if len(gas) > 1:
             fail("materials", f"one explosive (jwl) material at most (got {', '.join(gas)})")
         for m in gas:
@@ -323,6 +323,18 @@ class Scene:
     def material_ids(self) -> dict[str, int]:
         """Material name -> id, in the order the scene defines them."""
         return {m: k for k, m in enumerate(self.materials)}
+
+    @property
+    def gas_materials(self) -> list[str]:
+        """The materials whose points are the updated-Lagrangian gas (family "ul"),
+        in scene order: the one place that tells the gas from the solids."""
+        return [m for m, mat in self.materials.items() if mat.family == "ul"]
+
+    @property
+    def gas_parts(self) -> list[int]:
+        """Indices of the parts made of a gas material."""
+        gas = set(self.gas_materials)
+        return [k for k, q in enumerate(self.parts) if q.material in gas]
 
     @property
     def can_fail(self) -> bool:

@@ -30,8 +30,16 @@ STATE_OUTPUTS = {"D": "jh2_damage", "pressure": "pressure", "eps_p": "plastic_st
                  "strain_rate": "strain_rate"}
 
 
+#: model families: "tl" total-Lagrangian correspondence points (the solids), "ul"
+#: updated-Lagrangian points (the explosive gas, mpipd.model.gas)
+FAMILIES = ("tl", "ul")
+
+
 class Material:
     """Mixin for material dataclasses with ``density``, ``bulk_modulus``, ``shear_modulus``."""
+
+    #: the model family whose points this material's parts are (FAMILIES)
+    family = "tl"
 
     def check(self, path):
         positive(self, path, "density", "bulk_modulus", "shear_modulus")
@@ -60,6 +68,12 @@ class Material:
     #: False for a material without a dissipation mechanism (the hypoelastic solid):
     #: its stress work is its stored energy and the ledger books no plastic part
     dissipative = True
+
+    def point_strength(self, state: dict, pos: int) -> float:
+        """The yield strength (Pa) of the ``pos``-th point of this material from its
+        history ``state`` (what a probe records); NaN for a material without a
+        strength model."""
+        return math.nan
 
     def elastic_energy(self, idx, sigma, J, mode, state, W, out):
         """out[i] = recoverable energy per reference volume (J/m^3) of the points

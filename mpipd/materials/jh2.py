@@ -255,6 +255,15 @@ class JH2(Material):
                    self.sigma_hel, self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T,
                    self.beta, self.D1, self.D2, self.rate_norm)
 
+    def point_strength(self, state: dict, pos: int) -> float:
+        """sigma_y = sigma_HEL sigma* (p*, edot*, D) of one point (Eqs. 20–22, the
+        update's own arithmetic: scalar log, the kernel's strength function)."""
+        es = state["strain_rate"][pos] / self.rate_norm
+        rate = 1.0 + self.C * math.log(es) if es > 1.0 else 1.0
+        ps = state["pressure"][pos] / self.p_HEL
+        return self.sigma_hel * jh2_strength(ps, rate, state["D"][pos], self.A, self.N,
+                                             self.B, self.M, self.T / self.p_HEL)
+
     def elastic_energy(self, idx, sigma, J, mode, state, W, out):
         jh2_elastic_energy(idx, sigma, J, mode, self.shear_modulus, self.bulk_modulus,
                            self.K2, self.K3, out)

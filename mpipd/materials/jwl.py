@@ -109,7 +109,7 @@ class Explosive(JWL):
     interacts_with: tuple[str, ...] = ()
     pressure_factor: float = 1.0
     tension: None = None
-    is_gas = True
+    family = "ul"                       # its points are the updated-Lagrangian gas
 
     def check(self, path):
         super().check(path)

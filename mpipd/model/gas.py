@@ -36,10 +36,12 @@ SKIN = 0.2
 
 
 class Gas:
-    def __init__(self, sim):
-        scene, p = sim.scene, sim.points
+    def __init__(self, scene, points, team):
+        """The gas of ``scene`` among this rank's ``points`` (collective: the search
+        reach is the largest gas horizon over all ranks)."""
+        p = points
         names = list(scene.materials)
-        explosives = [m for m in names if getattr(scene.materials[m], "is_gas", False)]
+        explosives = scene.gas_materials
         self.mat = scene.materials[explosives[0]]
         gas_ids = [names.index(m) for m in explosives]
         acts = {a for m in explosives for a in scene.materials[m].interacts_with}
@@ -60,7 +62,7 @@ class Gas:
         dx = float(p.dx[self.gas_idx].max()) if len(self.gas_idx) else 0.0
         self.t_ramp = m.burn_ramp * dx / m.vod
         self.gas_horizon = np.where(self.is_gas.astype(bool), p.horizon, 0.0)
-        self.reach = sim.team.max(float(self.gas_horizon.max()) if p.n_local else 0.0)
+        self.reach = team.max(float(self.gas_horizon.max()) if p.n_local else 0.0)
         self.V_ratio = np.ones(n)                # V_w / V0 of the owned gas (1 elsewhere)
         self.V_w = self.gd[:, GD_V].copy()          # this step's pair weights (start-of-step V)
         self.V_pw = self.V_w.copy()              # the last step's

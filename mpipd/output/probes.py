@@ -27,7 +27,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..materials.jh2 import jh2_strength
 from ..input.schema import fail
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
@@ -49,16 +48,20 @@ def part_matches(part: str, name: str) -> bool:
 
 
 class Probes:
-    def __init__(self, sim, probes):
-        self.sim = sim
+    def __init__(self, probes, scene, points, team, corr, v, mode):
+        """``probes``: the scene's; ``corr``: the correspondence model (stress of a
+        point, material groups); ``v`` and ``mode``: the State's velocities and
+        failure flags.  Collective (the nearest point is found over all ranks)."""
         self.probes = list(probes)
-        n = sim.points.n_owned
-        x = sim.points.x[:n]
-        gid = sim.points.gid[:n]
-        part = sim.points.part[:n]
-        mat = sim.points.material[:n]
-        parts = [q.name for q in sim.scene.parts]
-        self.part_names, self.material_names = parts, list(sim.scene.materials)
+        self.team, self.corr, self.v, self.mode = team, corr, v, mode
+        self.points = points
+        n = points.n_owned
+        x = points.x[:n]
+        gid = points.gid[:n]
+        part = points.part[:n]
+        mat = points.material[:n]
+        parts = [q.name for q in scene.parts]
+        self.part_names, self.material_names = parts, list(scene.materials)
         self.mine = []                      # (probe index, local index)
         self.notes = []                     # warnings for the run log
         self.gid, self.x, self.dist, self.part, self.material = [], [], [], [], []
@@ -69,9 +72,9 @@ class Probes:
                 d = np.where(ok[part], d, np.inf)
             j = int(np.argmin(d)) if n else -1
             best = ((float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
-                     int(mat[j]), float(sim.points.dx[j]), float(sim.points.horizon[j]))
+                     int(mat[j]), float(points.dx[j]), float(points.horizon[j]))
                     if n and np.isfinite(d[j]) else (math.inf, -1))
-            found = min(sim.team.gather(best))
+            found = min(team.gather(best))
             key = f"probes[{k}].position"
             if not math.isfinite(found[0]):
                 fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
@@ -97,11 +100,13 @@ class Probes:
         # continues them): most compressive sigma_rr, largest |v_r|, largest p
         self.peak = {k: [math.inf, 0.0, -math.inf] for k, _ in self.mine}
         self.start = {k: 0 for k, _ in self.mine}       # step of the first buffered row
-        self._jh2 = {}
-        for g in sim.corr.groups:
-            if g.material.registry_name == "jh2":
-                for pos, i in enumerate(g.idx):
-                    self._jh2[int(i)] = (g, pos)
+        # each probe point's material group and its row there (the material gives
+        # the strength, or NaN if it has none)
+        self._group = {}
+        mine = {i for _, i in self.mine}
+        for g in corr.groups:
+            for pos in np.flatnonzero(np.isin(g.idx, list(mine))):
+                self._group[int(g.idx[pos])] = (g, int(pos))
 
     def peaks(self) -> dict:
         """name -> (most compressive sigma_rr, largest |v_r|, largest p) so far, gathered
@@ -109,26 +114,26 @@ class Probes:
         local = {self.probes[k].name: tuple(pk) for k, pk in self.peak.items()
                  if math.isfinite(pk[0])}
         out = {}
-        for part in self.sim.team.gather(local):
+        for part in self.team.gather(local):
             out.update(part)
         return out
 
-    def sample(self):
-        sim = self.sim
+    def sample(self, step: int, t: float):
+        """Record step ``step`` (time ``t``) at every probe this rank owns."""
         for k, i in self.mine:
             pr = self.probes[k]
-            s = sim.corr.cauchy_stress_of(i)
-            dx, dy = sim.points.x[i, 0] - pr.center[0], sim.points.x[i, 1] - pr.center[1]
+            s = self.corr.cauchy_stress_of(i)
+            dx, dy = self.points.x[i, 0] - pr.center[0], self.points.x[i, 1] - pr.center[1]
             r = math.hypot(dx, dy) or 1.0
             c, sn = dx / r, dy / r
             srr = s[0] * c * c + s[1] * sn * sn + 2 * s[5] * c * sn
-            vr = sim.v[i, 0] * c + sim.v[i, 1] * sn
+            vr = self.v[i, 0] * c + self.v[i, 1] * sn
             p = -(s[0] + s[1] + s[2]) / 3.0
             dev = np.array([s[0] + p, s[1] + p, s[2] + p])
             seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
             if not self.rows[k]:
-                self.start[k] = sim.step_count
-            row = (sim.t, srr, vr, p, seq, self._strength(i))
+                self.start[k] = step
+            row = (t, srr, vr, p, seq, self._strength(i))
             self.rows[k].append(row)
             pk = self.peak[k]
             pk[0], pk[1], pk[2] = min(pk[0], srr), max(pk[1], abs(vr)), max(pk[2], p)
@@ -140,15 +145,11 @@ class Probes:
                 self.peak[k] = list(peaks[self.probes[k].name])
 
     def _strength(self, i) -> float:
-        if i not in self._jh2 or self.sim.mode[i] != 0:
-            return math.nan if i not in self._jh2 else 0.0
-        g, pos = self._jh2[i]
-        m, st = g.material, g.state
-        es = st["strain_rate"][pos] / m.rate_norm
-        rate = 1.0 + m.C * math.log(es) if es > 1.0 else 1.0
-        ps = st["pressure"][pos] / m.p_HEL
-        return m.sigma_hel * jh2_strength(ps, rate, st["D"][pos], m.A, m.N, m.B, m.M,
-                                          m.T / m.p_HEL)
+        """The material's strength at point i (Material.point_strength: NaN for a
+        material without one), 0 once the point has failed."""
+        g, pos = self._group[i]
+        s = g.material.point_strength(g.state, pos)
+        return s if math.isnan(s) or self.mode[i] == 0 else 0.0
 
     def create(self, h5, n_rows: int):
         """Collective: datasets for every probe (all ranks call this)."""

@@ -201,12 +201,12 @@ def local_points(scene, slabs: Slabs, r: int) -> Points:
 
 
 def replicated_parts(scene) -> list[int]:
-    """Indices of the parts every rank holds whole: the explosive gas (``is_gas``
+    """Indices of the parts every rank holds whole: the explosive gas (``gas_materials``
     materials) and the parts of every material an explosive ``interacts_with``.
     A gas point's current family is every such point within its horizon of its
     current position, which may be any distance from its owner's slab."""
     mats = scene.materials
-    gas = {m for m, mat in mats.items() if getattr(mat, "is_gas", False)}
+    gas = set(scene.gas_materials)
     acts = {a for m in gas for a in mats[m].interacts_with}
     return [k for k, q in enumerate(scene.parts) if q.material in gas | acts]
 
