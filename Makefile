@@ -13,7 +13,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install paraview demo test bench clean
+.PHONY: install paraview demo test bench lint clean
 
 install: $(STAMP)
 
@@ -36,6 +36,10 @@ test: install paraview
 
 bench: install
 	$(PY) benchmarks/run.py
+
+# ruff (lint + import order), configured in pyproject.toml; tests/test_lint.py runs it too
+lint: install
+	$(VENV)/bin/ruff check .
 
 clean:
 	rm -rf runs .pytest_cache

@@ -15,9 +15,9 @@ import time
 
 from mpi4py import MPI
 
-from mpipd.parallel.team import Team
-from mpipd.input.schema import build
 from mpipd.input.scene import OUTPUT_FIELDS, Scene
+from mpipd.input.schema import build
+from mpipd.parallel.team import Team
 from mpipd.solver import Simulation
 
 PEAKS = ("peak_pressure", "peak_sigma_rr", "peak_speed")

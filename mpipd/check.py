@@ -36,8 +36,8 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .parallel.decomp import decompose, halo_width, replicated_parts
 from .input.geometry import LayerTable
+from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
@@ -90,8 +90,8 @@ def bulk_family(dx: float, horizon: float) -> np.ndarray:
     """Bond lengths |xi| of a bulk lattice point's family."""
     n = int(math.ceil(horizon / dx))
     k = np.arange(-n, n + 1)
-    I, J, K = np.meshgrid(k, k, k, indexing="ij")
-    r = dx * np.sqrt(I * I + J * J + K * K).ravel()
+    kx, ky, kz = np.meshgrid(k, k, k, indexing="ij")
+    r = dx * np.sqrt(kx * kx + ky * ky + kz * kz).ravel()
     return r[(r > 0) & (r < horizon)]
 
 

@@ -78,8 +78,8 @@ def _error(msg: str) -> int:
 
 
 def _guard_serial(fn, args) -> int:
-    from .parallel.decomp import DecompositionError
     from .input.schema import SceneError
+    from .parallel.decomp import DecompositionError
     try:
         return fn(args)
     except (SceneError, DecompositionError, UsageError) as e:
@@ -112,8 +112,8 @@ def cmd_cases(args) -> int:
 # ----------------------------------------------------------------------------- check
 
 def cmd_check(args) -> int:
-    from .input import scene as sc
     from .check import check_report
+    from .input import scene as sc
     if args.ranks < 1:
         raise UsageError(f"--ranks must be >= 1 (got {args.ranks})")
     scene, _ = sc.load(args.scene, args.set)
@@ -139,13 +139,13 @@ def _bad_input(team, exc) -> int:
 
 
 def _run(args, team, signals=None) -> int:
+    from .check import critical_dt
+    from .input import scene as sc
+    from .input.geometry import check_parts
+    from .input.schema import SceneError
     from .output import checkpoint as ck
     from .output import rundir
-    from .input import scene as sc
     from .parallel.decomp import DecompositionError
-    from .input.geometry import check_parts
-    from .check import critical_dt
-    from .input.schema import SceneError
     from .solver import Simulation
 
     bad_input = (SceneError, DecompositionError, UsageError, ck.CheckpointError,

@@ -26,19 +26,20 @@ import time as _time
 
 import numpy as np
 
-from .model.correspondence import Correspondence
-from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
-from .model.failure import Failure
-from .model.families import build_families
 from .input.geometry import LayerTable
-from .model.gas import Gas
-from .parallel.halo import Halo
-from .model.interface import InterfaceCorrection, needed as interface_needed
 from .kernels import integrate, runaway
 from .kernels.layout import CORRESPONDENCE, N_MODES, SPRING_F
+from .model.correspondence import Correspondence
+from .model.failure import Failure
+from .model.families import build_families
+from .model.gas import Gas
+from .model.interface import InterfaceCorrection
+from .model.interface import needed as interface_needed
 from .model.ledger import Energies, Ledger
 from .output.peaks import Peaks
 from .output.probes import Probes
+from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
+from .parallel.halo import Halo
 from .state import AUX, LAST, LOCAL, State
 
 

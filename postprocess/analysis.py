@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import cracks, errors, explosive, lattice_bias, ledger, peaks, probe_metrics as pm
-from . import sections as secs, volume
+from . import cracks, errors, explosive, lattice_bias, ledger, peaks, volume
+from . import probe_metrics as pm
+from . import sections as secs
 from .targets import TARGETS, verdict
 
 CRACK_SECTIONS = (secs.NAMED[0], secs.NAMED[2], secs.NAMED[4])

@@ -10,13 +10,15 @@ The report reads whichever terms the file has (older files: kinetic, strain, gas
 total, external, hourglass), gives the final value of each and the largest
 |balance|.  A term that must be non-negative (``mpipd.model.ledger.NON_NEGATIVE``) going
 below -BALANCE_TOL (1e-3) of the ledger's scale (the largest magnitude of any J
-term at any frame; the solver's own check uses the same tolerance) is an error: it is reported as such and its values are not shown as numbers.
+term at any frame; the solver's own check uses the same tolerance) is an error: it
+is reported as such and its values are not shown as numbers.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from mpipd.model.ledger import BALANCE_TOL as TOL, DISSIPATED, HELD, NON_NEGATIVE
+from mpipd.model.ledger import BALANCE_TOL as TOL
+from mpipd.model.ledger import DISSIPATED, HELD, NON_NEGATIVE
 
 BOOKS = ("initial", "external")
 TERMS = HELD + DISSIPATED + BOOKS

@@ -10,7 +10,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from . import figures_curves as fc, figures_maps as fmap
+from . import figures_curves as fc
+from . import figures_maps as fmap
 from .analysis import analyse
 from .model import load_model
 from .reader import Run

@@ -41,8 +41,8 @@ def scene_dict(shape, dx=1e-3, dt=5e-8, steps=10, hourglass=0.01, initial=(), bo
 
 
 def make_scene(d):
-    from mpipd.input.schema import build
     from mpipd.input.scene import Scene
+    from mpipd.input.schema import build
     return build(Scene, d)
 
 

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import make_scene, scene_dict, run_cli
+from conftest import make_scene, run_cli, scene_dict
 
 from mpipd.input.loads import BoreholePressure
 from mpipd.input.schema import SceneError, build

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from conftest import granite, make_scene, scene_dict
 
-from mpipd.parallel.decomp import DecompositionError, decompose, halo_width, local_points
-from mpipd.model.families import build_families
 from mpipd.input.geometry import LayerTable, fill_layers
+from mpipd.model.families import build_families
+from mpipd.parallel.decomp import DecompositionError, decompose, halo_width, local_points
 
 
 def two_part_scene():

@@ -200,8 +200,8 @@ def beyond_static_halo(scene, ranks, y, is_gas, is_solid):
     (slabs.reach): the pairs a rank can only see if it holds that copper anyway."""
     from scipy.spatial import cKDTree
 
-    from mpipd.parallel.decomp import decompose, halo_width
     from mpipd.input.geometry import LayerTable
+    from mpipd.parallel.decomp import decompose, halo_width
     table = LayerTable.from_parts(scene.parts, scene.material_ids)
     slabs = decompose(table, ranks, halo_width(scene))
     horizon = max(q.horizon for q in scene.parts if q.material == "explosive")

@@ -17,9 +17,9 @@ import pytest
 from conftest import granite, make_scene, scene_dict
 
 from mpipd.input import scene as sc
-from mpipd.parallel.decomp import decompose, halo_width, local_points
 from mpipd.input.geometry import LayerTable, balls_inside
 from mpipd.input.schema import SceneError
+from mpipd.parallel.decomp import decompose, halo_width, local_points
 from mpipd.solver import Simulation
 
 OMEGA = {

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from mpipd.materials.jh2 import JH2, jh2_pressure
 from mpipd.input.schema import build
+from mpipd.materials.jh2 import JH2, jh2_pressure
 
 M = JH2()                                # Table 1 granite
 G, K1, K2, K3 = M.shear_modulus, M.bulk_modulus, M.K2, M.K3

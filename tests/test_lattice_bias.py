@@ -7,7 +7,8 @@ gives 0 although the lattice's own angular density is not uniform."""
 import numpy as np
 import pytest
 
-from postprocess import cracks, lattice_bias as lb
+from postprocess import cracks
+from postprocess import lattice_bias as lb
 
 DX, R_WALL, R_OUT = 1e-3, 3.2e-3, 30e-3
 CENTER = (0.0, 0.0)

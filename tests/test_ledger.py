@@ -7,7 +7,6 @@ term out must break the bound: the check can fail.
 """
 import sys
 
-import numpy as np
 import pytest
 from conftest import ROOT
 

@@ -2,8 +2,8 @@
 counted by walking every array the simulation holds."""
 import pytest
 
-from mpipd.input import scene as sc
 from mpipd.check import BYTES_PER_BOND, BYTES_PER_GAS_POINT, BYTES_PER_UL_POINT, memory_model
+from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from conftest import make_scene, scene_dict
 
-from mpipd.materials.jh2 import JH2, jh2_pressure
 from mpipd.kernels.layout import MODE_TENSION
+from mpipd.materials.jh2 import JH2, jh2_pressure
 from mpipd.solver import Simulation
 
 L, DX = 0.011, 1e-3

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import run_cli
 
-from mpipd.output import checkpoint as ck
 from mpipd.input import scene as sc
+from mpipd.output import checkpoint as ck
 from mpipd.solver import Simulation
 
 ARGS = ["--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=1.2e-5",
@@ -203,7 +203,6 @@ def test_checkpoint_when_one_rank_has_no_point_of_a_material(tmp_path):
     assert res.returncode == 0, res.stdout + res.stderr
     with h5py.File(a / "checkpoint.h5", "r") as f:
         hist = {k: f[f"points/state1/{k}"][...] for k in f["points/state1"]}
-        mat = f["points/material"][...] if "points/material" in f else None
     assert hist and any(np.any(v != 0) for v in hist.values()), "no J2 history to test"
     res = run_cli(["run", "--restart", str(a / "checkpoint.h5"), "--quiet"], ranks=3,
                   timeout=300)

@@ -4,8 +4,12 @@ import math
 import numpy as np
 import pytest
 
-from mpipd.materials.tension import (TensionFailure, dynamic_strength, principal_max_min,
-                                     tension_check)
+from mpipd.materials.tension import (
+    TensionFailure,
+    dynamic_strength,
+    principal_max_min,
+    tension_check,
+)
 
 
 def test_principal_stresses_match_numpy():

@@ -39,10 +39,10 @@ from scipy.special import h2vp, hankel2
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from mpipd.input.loads import BoreholePressure           # noqa: E402
-from mpipd.input.scene import parse                      # noqa: E402
-from postprocess import arrivals                   # noqa: E402
-from postprocess.model import split_scene_text     # noqa: E402
+from mpipd.input.loads import BoreholePressure  # noqa: E402
+from mpipd.input.scene import parse  # noqa: E402
+from postprocess import arrivals  # noqa: E402
+from postprocess.model import split_scene_text  # noqa: E402
 
 PROBES = ("A", "B", "C", "D", "E", "F", "G")
 HERE = Path(__file__).resolve().parent

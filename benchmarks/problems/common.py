@@ -14,8 +14,8 @@ def granite():
 
 
 def build_scene(d):
-    from mpipd.input.schema import build
     from mpipd.input.scene import Scene
+    from mpipd.input.schema import build
     return build(Scene, d)
 
 

@@ -109,8 +109,8 @@ class JH2Point:
     serial_only = True
 
     def run(self, team, n_steps, steps=None):
-        from mpipd.materials.jh2 import JH2
         from mpipd.input.schema import build
+        from mpipd.materials.jh2 import JH2
         prm = dict(JH2_TABLE1, D1=self.D1)
         mat = build(JH2, {"D1": self.D1})
         dt = self.EPS_END / self.RATE / n_steps

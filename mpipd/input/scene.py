@@ -33,19 +33,19 @@ Bad input raises :class:`mpipd.input.schema.SceneError` with one line naming the
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import tomllib
 
-from .geometry import SHAPES
 from ..kernels.influence import CODES as INFLUENCE
-from .loads import BOUNDARIES, INITIAL, LOADS
 from ..materials import MATERIALS
 from ..output.probes import Probe, part_matches
+from .geometry import SHAPES
+from .loads import BOUNDARIES, INITIAL, LOADS
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3

@@ -7,8 +7,9 @@ dual horizons) on point i is P g_i with the purely geometric vector
 
 (omega_i with point i's influence function and horizon, omega_j with j's; see
 mpipd.kernels.influence), which vanishes by symmetry inside a uniform lattice
-but not where horizons, spacings or influence functions change.  The correction subtracts P_i g_i = A_i q_i at the chosen
-points, with A_i = P_i K_i^-1 = B_i + h_i F_i (the force data) and q_i = K_i g_i.
+but not where horizons, spacings or influence functions change.  The correction
+subtracts P_i g_i = A_i q_i at the chosen points, with A_i = P_i K_i^-1 = B_i + h_i F_i
+(the force data) and q_i = K_i g_i.
 """
 import math
 

@@ -38,7 +38,16 @@ import numpy as np
 
 from .contact import contact_force
 from .influence import influence
-from .layout import CORRESPONDENCE, FD_H, FD_SPRING, FD_VISC_L, FD_VISC_Q, NOT_TL, SPRING_F, SPRING_K
+from .layout import (
+    CORRESPONDENCE,
+    FD_H,
+    FD_SPRING,
+    FD_VISC_L,
+    FD_VISC_Q,
+    NOT_TL,
+    SPRING_F,
+    SPRING_K,
+)
 from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
 from .viscosity import viscous_bond
 

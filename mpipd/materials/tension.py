@@ -25,7 +25,6 @@ from ..input.schema import fail, join, non_negative, positive
 from ..kernels.layout import MODE_TENSION
 
 
-
 @numba.njit(cache=True, inline="always")
 def principal_max_min(a00, a11, a22, a12, a02, a01):
     """Largest and smallest eigenvalue of a symmetric 3x3 matrix (closed form)."""

@@ -24,8 +24,7 @@ import math
 import numpy as np
 
 from ..kernels import energy, integrate, nosb, rotation
-from ..kernels.layout import (CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F,
-                             SPRING_K)
+from ..kernels.layout import CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F, SPRING_K
 from ..kernels.viscosity import viscosity_data
 from ..materials.base import STATE_OUTPUTS
 from ..state import AUX, LAST, LOCAL, REBUILT

@@ -30,6 +30,7 @@ from scipy.spatial import cKDTree
 from ..kernels.breakage import break_bonds, pairs_from_lists, pd_damage
 from ..state import LOCAL
 
+
 class Failure:
     def __init__(self, points, families, halo, corr, damping: float, damp, tl, mode,
                  ledger=None):

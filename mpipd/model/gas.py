@@ -26,10 +26,10 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .families import _csr_by_row
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.ul import gas_gather, gas_update
 from ..state import AUX, LOCAL
+from .families import _csr_by_row
 
 #: Verlet skin of the gas families, as a fraction of the gas horizon
 SKIN = 0.2

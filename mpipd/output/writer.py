@@ -35,9 +35,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..input.scene import OUTPUT_FIELDS
 from ..kernels.linalg import VOIGT
 from ..model.ledger import TERMS
-from ..input.scene import OUTPUT_FIELDS
 
 
 def git_commit() -> str:

@@ -1,0 +1,61 @@
+"""docs/architecture.md's ownership table says what the State registry says: each
+listed array is registered, by the owner the table names, exchanged and
+checkpointed as the table says (a table that drifts from the code fails here)."""
+import re
+from pathlib import Path
+
+import pytest
+
+from mpipd.input import scene as sc
+from mpipd.solver import Simulation
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "architecture.md"
+#: the reduced blast_demo of tests/test_state.py, with the peaks asked for: every
+#: model of the table exists in it (gas, failure, interface correction, peaks)
+OVER = ["parts.0.shape.z=[0.0, 0.003]", "parts.1.shape.z=[0.0, 0.003]",
+        "parts.2.shape.z=[0.0, 0.003]", "parts.2.shape.radius=0.012", "time.t_end=4e-7",
+        "probes=[]", 'output.fields=["u","peak_pressure","peak_speed","damage"]']
+
+
+def table_rows():
+    text = DOC.read_text()
+    part = text.split("## Who owns which array", 1)[1].split("\n## ", 1)[0]
+    rows = []
+    for line in part.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 5 or cells[0] in ("array", "---") or set(cells[0]) <= set("-"):
+            continue
+        names = re.findall(r"`([^`]+)`", cells[0])
+        rows.append((names, *cells[1:]))
+    return rows
+
+
+def test_table_is_not_empty():
+    assert len(table_rows()) >= 15
+
+
+@pytest.fixture(scope="module")
+def state(team):
+    scene, _ = sc.load("blast_demo", OVER)
+    return Simulation(scene, team).state
+
+
+@pytest.mark.parametrize("row", table_rows(), ids=lambda r: r[0][0])
+def test_row_matches_registry(state, row):
+    names, owner, rows, exchanged, checkpoint = row
+    for name in names:
+        if "<" in name:                                  # state<mid>/<name>: per material
+            assert any(k.startswith("state") and "/" in k for k in state.fields)
+            continue
+        assert name in state.fields, f"{name}: not registered"
+        f = state.fields[name]
+        assert f.owner == owner, (name, f.owner, owner)
+        if not exchanged.startswith("yes,"):             # "yes, if ...": scene-dependent
+            assert f.exchanged == exchanged.startswith("yes"), (name, f.exchanged, exchanged)
+        if checkpoint.startswith("yes"):
+            assert f.checkpoint, name
+            phase = {"(after initialize)": "last", "(after the rebuild)": "rebuilt"}
+            want = next((v for k, v in phase.items() if k in checkpoint), "state")
+            assert f.restore == want, (name, f.restore, want)
+        else:
+            assert not f.checkpoint, name
