@@ -6,8 +6,9 @@
 For each case and rank count, runs benchmarks/case.py of OLD and of NEW
 alternately (``repeat`` times each, so drifts of this noisy machine hit both),
 and prints per case the best bond-steps/s per core of each and NEW/OLD - 1.
-Each checkout is imported through PYTHONPATH with this interpreter (the same
-venv for both).
+Each checkout is imported with this interpreter (the same venv for both) through
+benchmarks/checkout_run.py, which sets the editable install's finder aside (with
+PYTHONPATH alone both runs would import the installed tree).
 """
 import argparse
 import os
@@ -16,14 +17,15 @@ import subprocess
 import sys
 from pathlib import Path
 
+LAUNCHER = Path(__file__).resolve().parent / "checkout_run.py"
 CASES = "elastic,jh2,blast,blast_mr,jh2_refresh,blast_refresh"
 
 
 def run_case(checkout: Path, case: str, ranks: int, size: int, steps: int) -> float:
-    env = dict(os.environ, PYTHONPATH=str(checkout), OMPI_ALLOW_RUN_AS_ROOT="1",
-               OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
-    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable,
-           str(checkout / "benchmarks" / "case.py"), case, "--size", str(size),
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMP_NUM_THREADS="1")
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(LAUNCHER),
+           str(checkout), str(checkout / "benchmarks" / "case.py"), case, "--size", str(size),
            "--steps", str(steps)]
     res = subprocess.run(cmd, env=env, capture_output=True, text=True)
     m = re.search(r"bond_steps_per_s_per_core=([0-9.eE+-]+)", res.stdout)

@@ -8,14 +8,16 @@ the run's :class:`mpipd.parallel.team.Team`:
 2. halo plan, families (CSR, gid-sorted), material groups, correspondence state;
 3. initial and boundary conditions, initial forces.
 
-One step (velocity Verlet, DESIGN §4)::
+One step (velocity Verlet, DESIGN §4), over the scene's models
+(:class:`mpipd.model.base.Model`: the correspondence solids, then each further
+model family the scene's materials name, :data:`FAMILY_MODELS`)::
 
     kick_drift                      v += dt/2 a; u += dt v   (owned)
     halo: u, v                      owned -> ghosts
-    deform, rotate, update_stress   F, Fdot, R, V, d, sigma  (owned)
-    force_data                      B, h                      (owned)
-    halo: force data                owned -> ghosts
-    gather                          f_i from own + ghost data (owned)
+    model.update                    F, Fdot, R, V, d, sigma; the gas's pressure (owned)
+    model.force_data                B, h; the gas's A, V, p (owned)
+    halo: every model's force data  owned -> ghosts (one call)
+    model.gather                    f_i from own + ghost data (owned)
     kick                            a = f / rho; v += dt/2 a
 
 No MPI call appears here except through the halo and the team.
@@ -28,7 +30,8 @@ import numpy as np
 
 from .input.geometry import LayerTable
 from .kernels import integrate, runaway
-from .kernels.layout import CORRESPONDENCE, N_MODES, SPRING_F
+from .kernels.layout import N_MODES
+from .model.base import Model
 from .model.correspondence import Correspondence
 from .model.failure import Failure
 from .model.families import build_families
@@ -41,6 +44,11 @@ from .output.probes import Probes
 from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
 from .parallel.halo import Halo
 from .state import AUX, LAST, LOCAL, State
+
+#: model family (``Material.family``) -> the model its points are, beyond the
+#: correspondence solids ("tl", always built: it holds every point's kinematics);
+#: built as ``cls(scene, points, team)`` when some part is of such a material
+FAMILY_MODELS: dict[str, type[Model]] = {"ul": Gas}
 
 
 class Unstable(RuntimeError):
@@ -93,8 +101,9 @@ class Simulation:
 
         sv = scene.solver
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
-                                   contact=sv.contact, viscosity=sv.viscosity, tl=self.tl)
-        self.corr.register(st, self.mode)
+                                   self.mode, contact=sv.contact, viscosity=sv.viscosity,
+                                   tl=self.tl)
+        self.corr.register(st)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
         # the ghost-force correction exists only where dx or the horizon changes
         tl_parts = [q for k, q in enumerate(scene.parts) if k not in gas_parts]
@@ -103,6 +112,7 @@ class Simulation:
                           if interface_needed(scene, tl_parts) else None)
         if self.interface is not None:
             self.interface.register(st)
+            self.corr.attach_interface(self.interface)      # a post-gather step of corr
         # damping (Eq. 41 for phi = 1, and the gas's own), only if some is asked for
         needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
         self.damp = st.add("damp", "solver", np.zeros(n if needs_damp else 0))
@@ -114,10 +124,16 @@ class Simulation:
                                 self.tl, self.mode, self.ledger) if scene.can_fail else None)
         if self.failure is not None:
             self.failure.register(st)
-        # the explosive gas exists only if the scene has one
-        self.gas = Gas(scene, p, team) if gas_parts else None
-        if self.gas is not None:
-            self.gas.register(st)
+        # the models of the further families the scene's parts use (the explosive gas)
+        self.models: list[Model] = [self.corr]
+        used = {scene.materials[q.material].family for q in scene.parts}
+        for family, cls in FAMILY_MODELS.items():
+            if family in used:
+                model = cls(scene, p, team)
+                model.register(st)
+                self.models.append(model)
+        self.gas = next((m for m in self.models if isinstance(m, Gas)), None)
+        if self.gas is not None:                # the gas's own damping (paper §2.6)
             self.damp[self.gas.gas_idx] = self.gas.mat.damping
         # time-dependent body forces (none: no arrays, no calls)
         self.loads = [ld.prepare(scene.parts, p) for ld in scene.loads]
@@ -153,7 +169,8 @@ class Simulation:
             self.corr.initial_volume()
             self.corr.W[:] = 0.0
             self.corr.W[:] = self.corr.elastic_energy(self.mode)
-        self.corr.commit()
+        for m in self.models:
+            m.commit()
         self.compute_forces()
         self.apply_loads(self.t, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
@@ -162,19 +179,14 @@ class Simulation:
 
     # ------------------------------------------------------------------ pipeline
     def compute_forces(self):
-        """Force data of owned points -> halo -> gathered internal force density."""
-        toggled = self.corr.force_data()
-        if len(toggled):                            # points that switched to/from SPRING_F
-            self._book_toggles(toggled)
-        if self.gas is not None:
-            self.halo.exchange(self.corr.fd, self.gas.gd)
-        else:
-            self.halo.exchange(self.corr.fd)
-        self.corr.gather(self.u, self.v, self.f, self.ledger.fv)
-        if self.interface is not None:
-            self.interface.apply(self.corr.fd, self.corr.F, self.f)
-        if self.gas is not None:
-            self.gas.gather(self.u, self.f)
+        """Every model's force data of owned points -> one halo call -> each model's
+        internal force density gathered into f, in the models' order."""
+        moved = []
+        for m in self.models:
+            moved.extend(m.force_data(self.u, self.ledger))
+        self.halo.exchange(*moved)
+        for m in self.models:
+            m.gather(self.u, self.v, self.f, self.ledger.fv)
 
     def _refresh_forces(self, dt: float):
         """Forces of the state after this step's breakage, for the next half kick
@@ -187,17 +199,6 @@ class Simulation:
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
         self.ledger.start(self.interface)
         self.ledger.jumps += before - self.ledger.integrator(self)
-
-    def _book_toggles(self, rows):
-        """A point whose F became singular (or regular again) switched between the
-        correspondence model and the bond-spring fallback: its held potentials
-        jump; the ledger books before - after."""
-        c = self.corr
-        now = c.spring[rows].copy()
-        c.spring[rows] = np.where(now == SPRING_F, CORRESPONDENCE, SPRING_F).astype(np.uint8)
-        before = c.potentials(rows, self.u)
-        c.spring[rows] = now
-        self.ledger.book_jump(before, c.potentials(rows, self.u))
 
     def apply_loads(self, t: float, dt: float):
         """Add the loads' body forces at time t to f; accumulate their work over the
@@ -215,15 +216,13 @@ class Simulation:
     def update(self, dt: float):
         """Everything between the two half kicks: kinematics, stress, forces."""
         self.halo.exchange(self.u, self.v)
-        if self.gas is not None:                    # Eqs. 45–48, detonation
-            self.gas.update(self.u, self.v, dt, self.t + dt)
-        self.corr.deform(self.u, self.v)
-        self.corr.rotate(dt)
-        self.corr.update_stress(dt, self.mode)
+        for m in self.models:                       # stress; the gas: Eqs. 45–48, detonation
+            m.update(self.u, self.v, dt, self.t + dt)
         self.compute_forces()
         if self.loads:
             self.apply_loads(self.t + dt, dt)
-        self.corr.commit()
+        for m in self.models:
+            m.commit()
 
     def step(self):
         dt = self.dt
@@ -303,9 +302,8 @@ class Simulation:
         """Rebuild, from a restored state, what follows from it: the gas's pair-weight
         ghosts, the shape tensors, the failure flags' ghosts, damage and damped set
         (mpipd.output.checkpoint.restore, step 2)."""
-        if self.gas is not None:
-            self.gas.after_restore(self.halo)
-        self.corr.after_restore()
+        for m in self.models:
+            m.after_restore(self.halo)
         if self.failure is not None:
             self.failure.after_restore()
             if self.interface is not None:  # retired where bonds broke or families failed

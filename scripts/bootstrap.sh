@@ -28,7 +28,7 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 PY="$VENV/bin/python"
 "$PY" -m pip install -q --upgrade pip "setuptools>=70" wheel
-"$PY" -m pip install -q numpy scipy numba pytest matplotlib "cython>=3" pkgconfig ruff
+"$PY" -m pip install -q numpy scipy numba pytest matplotlib "cython>=3" pkgconfig "ruff==0.17.6"
 
 # mpi4py and h5py from source against the system MPI / parallel HDF5.
 if ! "$PY" -c "import mpi4py" 2>/dev/null; then

@@ -38,8 +38,9 @@ import math
 import numba
 import numpy as np
 
+from ..materials.jwl import jwl_cold
 from .layout import GD_P, GD_V
-from .linalg import inv3
+from .linalg import det3, inv3
 
 #: fewest current neighbours, and smallest det M / (tr M / 3)^3, for a gas point to act
 MIN_NEIGHBOURS = 6
@@ -120,9 +121,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         M[2, 0] = M[0, 2]
         M[2, 1] = M[1, 2]
         tr = M[0, 0] + M[1, 1] + M[2, 2]
-        det = (M[0, 0] * (M[1, 1] * M[2, 2] - M[1, 2] * M[2, 1])
-               - M[0, 1] * (M[1, 0] * M[2, 2] - M[1, 2] * M[2, 0])
-               + M[0, 2] * (M[1, 0] * M[2, 1] - M[1, 1] * M[2, 0]))
+        det = det3(M)
         # a gas point that has lost its neighbourhood (escaped through a crack, or
         # with neighbours nearly coplanar) carries no pressure force
         singular = nb < MIN_NEIGHBOURS or not det > RCOND_M * (tr / 3.0) ** 3
@@ -140,8 +139,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         lam = 0.0 if lam < 0.0 else (1.0 if lam > 1.0 else lam)
         VR = V_new / V0[k]
         lk = lam * kfac
-        f = (A * (1.0 - w / (R1 * VR)) * math.exp(-R1 * VR)
-             + B * (1.0 - w / (R2 * VR)) * math.exp(-R2 * VR))
+        f = jwl_cold(VR, A, B, R1, R2, w)          # Eq. 48 without w e / V
         bb = V_old * trL * dt                   # W_b = p^{n+1} bb (0 if singular)
         e[k] = (e[k] * V0[k] - 0.5 * W_a - 0.5 * lk * f * bb) / (V0[k] + 0.5 * lk * w * bb / VR)
         p = lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0

@@ -12,13 +12,13 @@ G 45 GPa, sigma_y 450 MPa.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
 from ..input.schema import positive
+from ..kernels.plasticity import deviatoric_rate, radial_return, trial_deviator, von_mises
 from . import MATERIALS
 from .base import Material
 from .tension import TensionFailure
@@ -26,30 +26,25 @@ from .tension import TensionFailure
 
 @numba.njit(cache=True)
 def j2_update(idx, d, dt, sigma, mode, eps_p, K, G, sy):
-    s = np.empty(6)
+    """Advance the unrotated stress of the points ``idx`` (eps_p: compact, entry k
+    of point idx[k]); the radial return is mpipd.kernels.plasticity's."""
     for k in range(idx.shape[0]):
         i = idx[k]
         if mode[i] != 0:
             continue
         tr = d[i, 0] + d[i, 1] + d[i, 2]
         p_new = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0 + K * tr * dt
-        m = tr / 3.0
-        mean = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
-        for c in range(3):
-            s[c] = sigma[i, c] - mean + 2.0 * G * (d[i, c] - m) * dt
-        for c in range(3, 6):
-            s[c] = sigma[i, c] + 2.0 * G * d[i, c] * dt
-        seq = math.sqrt(1.5 * (s[0] ** 2 + s[1] ** 2 + s[2] ** 2
-                               + 2.0 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
+        s = trial_deviator(sigma, i, deviatoric_rate(d, i), G, dt)
+        seq = von_mises(s)
         if seq > sy:
-            f = sy / seq
-            for c in range(6):
-                s[c] *= f
+            s = radial_return(s, seq, sy)
             eps_p[k] += (seq - sy) / (3.0 * G)
-        for c in range(3):
-            sigma[i, c] = s[c] + p_new
-        for c in range(3, 6):
-            sigma[i, c] = s[c]
+        sigma[i, 0] = s[0] + p_new
+        sigma[i, 1] = s[1] + p_new
+        sigma[i, 2] = s[2] + p_new
+        sigma[i, 3] = s[3]
+        sigma[i, 4] = s[4]
+        sigma[i, 5] = s[5]
 
 
 @MATERIALS.register("j2")

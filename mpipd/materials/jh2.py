@@ -47,10 +47,10 @@ import numpy as np
 
 from ..input.schema import fail, join, non_negative, positive
 from ..kernels.layout import MODE_PLASTIC, MODE_TENSILE
+from ..kernels.plasticity import deviatoric_rate, equivalent_rate, radial_return, trial_deviator, von_mises
 from . import MATERIALS
 from .base import Material
 from .tension import TensionFailure
-
 
 
 @numba.njit(cache=True, inline="always")
@@ -146,34 +146,18 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
             for c in range(6):
                 sigma[i, c] = 0.0
             continue
-        # deviatoric rate and trial deviator
-        tr = (d[i, 0] + d[i, 1] + d[i, 2]) / 3.0
-        e0, e1, e2 = d[i, 0] - tr, d[i, 1] - tr, d[i, 2] - tr
-        e3, e4, e5 = d[i, 3], d[i, 4], d[i, 5]
-        sm = (sigma[i, 0] + sigma[i, 1] + sigma[i, 2]) / 3.0
-        s0 = sigma[i, 0] - sm + 2.0 * G * e0 * dt
-        s1 = sigma[i, 1] - sm + 2.0 * G * e1 * dt
-        s2 = sigma[i, 2] - sm + 2.0 * G * e2 * dt
-        s3 = sigma[i, 3] + 2.0 * G * e3 * dt
-        s4 = sigma[i, 4] + 2.0 * G * e4 * dt
-        s5 = sigma[i, 5] + 2.0 * G * e5 * dt
-        seq = math.sqrt(1.5 * (s0 * s0 + s1 * s1 + s2 * s2
-                               + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)))
-        edot = math.sqrt(2.0 / 3.0 * (e0 * e0 + e1 * e1 + e2 * e2
-                                      + 2.0 * (e3 * e3 + e4 * e4 + e5 * e5)))
+        # deviatoric rate and trial deviator (mpipd.kernels.plasticity)
+        e = deviatoric_rate(d, i)
+        s = trial_deviator(sigma, i, e, G, dt)
+        seq = von_mises(s)
+        edot = equivalent_rate(e)
         rate_out[k] = edot
         es = edot / rate_norm
         rate = 1.0 + C * math.log(es) if es > 1.0 else 1.0
         ps = p / p_hel
         sy = sigma_hel * jh2_strength(ps, rate, D[k], A, N, B, M, T_star)
         if seq > sy:
-            f = sy / seq if seq > 0.0 else 0.0
-            s0 *= f
-            s1 *= f
-            s2 *= f
-            s3 *= f
-            s4 *= f
-            s5 *= f
+            s = radial_return(s, seq, sy)
             deps = (seq - sy) / (3.0 * G)
             eps_p[k] += deps
             eps_f = D1 * (ps + T_star) ** D2
@@ -194,12 +178,12 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
                 dp[k] = -K1 * mu + math.sqrt(x * x + 2.0 * beta * K1 * dU)
                 p = p_eos + dp[k]
                 pressure[k] = p
-        sigma[i, 0] = s0 - p
-        sigma[i, 1] = s1 - p
-        sigma[i, 2] = s2 - p
-        sigma[i, 3] = s3
-        sigma[i, 4] = s4
-        sigma[i, 5] = s5
+        sigma[i, 0] = s[0] - p
+        sigma[i, 1] = s[1] - p
+        sigma[i, 2] = s[2] - p
+        sigma[i, 3] = s[3]
+        sigma[i, 4] = s[4]
+        sigma[i, 5] = s[5]
 
 
 @MATERIALS.register("jh2")

@@ -19,8 +19,11 @@ Isentropes of JWL are p_s(V) = A exp(-R1 V) + B exp(-R2 V) + C V^-(1 + w), with
 e_s(V) = (A/R1) exp(-R1 V) + (B/R2) exp(-R2 V) + (C/w) V^-w.
 
 The scene material ``model = "jwl"`` (:class:`Explosive`) is the explosive gas:
-updated-Lagrangian points (mpipd.model.gas) with this EOS, a programmed detonation
-and its own damping; it has no total-Lagrangian bonds.
+its parts are the "ul" model family, updated-Lagrangian points
+(:class:`mpipd.model.gas.Gas`) with this EOS, a programmed detonation and its own
+damping.  It is no correspondence material: it has no total-Lagrangian bonds, no
+stress update and no history; the registry holds it so that a scene names it
+like any material, and its moduli serve the stable-step estimate only.
 """
 from __future__ import annotations
 
@@ -35,10 +38,18 @@ from . import MATERIALS
 
 
 @numba.njit(cache=True, inline="always")
-def jwl_pressure(V, e, A, B, R1, R2, w):
-    """Eq. 48: pressure (Pa) at relative volume V and energy per initial volume e."""
+def jwl_cold(V, A, B, R1, R2, w):
+    """The energy-independent part of Eq. 48 at relative volume V (Pa):
+    f(V) = A (1 - w/(R1 V)) exp(-R1 V) + B (1 - w/(R2 V)) exp(-R2 V)."""
     return (A * (1.0 - w / (R1 * V)) * math.exp(-R1 * V)
-            + B * (1.0 - w / (R2 * V)) * math.exp(-R2 * V) + w * e / V)
+            + B * (1.0 - w / (R2 * V)) * math.exp(-R2 * V))
+
+
+@numba.njit(cache=True, inline="always")
+def jwl_pressure(V, e, A, B, R1, R2, w):
+    """Eq. 48: pressure (Pa) at relative volume V and energy per initial volume e,
+    p = f(V) + w e / V (f: :func:`jwl_cold`)."""
+    return jwl_cold(V, A, B, R1, R2, w) + w * e / V
 
 
 @dataclass(frozen=True)
@@ -61,8 +72,7 @@ class JWL:
         return jwl_pressure(V, e, self.A, self.B, self.R1, self.R2, self.omega)
 
     def _f(self, V):
-        return (self.A * (1 - self.omega / (self.R1 * V)) * math.exp(-self.R1 * V)
-                + self.B * (1 - self.omega / (self.R2 * V)) * math.exp(-self.R2 * V))
+        return jwl_cold(V, self.A, self.B, self.R1, self.R2, self.omega)
 
     def hugoniot_pressure(self, V: float) -> float:
         """Products' Hugoniot from the unreacted state (V = 1, p = 0, e = e0)."""
@@ -125,22 +135,12 @@ class Explosive(JWL):
 
     @property
     def shear_modulus(self) -> float:
+        """A gas carries no shear."""
         return 0.0
 
     @property
     def p_wave_speed(self) -> float:
         return self.vod
 
-    hourglass_modulus = 0.0
+    #: an explosive does not fail (no bonds; mpipd.input.scene.Scene.can_fail)
     can_fail = False
-
-    def new_state(self, n: int) -> dict:
-        return {}
-
-    def update(self, idx, d, J, dt, sigma, mode, state):
-        """The gas has no correspondence stress (mpipd.model.gas handles it)."""
-
-    def elastic_energy(self, idx, sigma, J, mode, state, W, out):
-        """No correspondence stress, no elastic energy (the gas's own energy is
-        booked as ``gas``)."""
-        out[idx] = 0.0

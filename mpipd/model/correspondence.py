@@ -7,15 +7,20 @@ calls the kernels of :mod:`mpipd.kernels.nosb` and
 :mod:`mpipd.kernels.rotation`; materials only see the unrotated rate of
 deformation ``d`` and update the unrotated stress of their own points.
 
-Step order (DESIGN §4, steps 4–8)::
+It is the "tl" model family (:class:`mpipd.model.base.Model`); its step
+(DESIGN §4, steps 4–8)::
 
-    deform(u, v)        F, Fdot                         Eqs. 5, 13
-    rotate(dt)          R, V, d, J (c det F)            Eqs. 6–14
-    update_stress(dt)   materials, stress work          Eq. 19 / 36
-    force_data()        B = P K^-1 - h F, h              Eqs. 2, 3, 15
+    update(u, v, dt)    deform: F, Fdot                  Eqs. 5, 13
+                        rotate: R, V, d, J (c det F)     Eqs. 6–14
+                        update_stress: materials, work   Eq. 19 / 36
+    force_data(u, ledger) B = P K^-1 - h F, h              Eqs. 2, 3, 15
     (halo exchange of fd)
-    gather(u, f)        internal force density           Eq. 1
+    gather(u, v, f, fv) internal force density           Eq. 1
+                        then the ghost-force correction  (mpipd.model.interface)
     commit()            F_old <- F
+
+The explosive's points ("ul" family) are rows here too (code NOT_TL in
+``spring``): they carry no material group, no bond and no force data.
 """
 from __future__ import annotations
 
@@ -28,6 +33,7 @@ from ..kernels.layout import CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL,
 from ..kernels.viscosity import viscosity_data
 from ..materials.base import STATE_OUTPUTS
 from ..state import AUX, LAST, LOCAL, REBUILT
+from .base import Model
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
 RCOND = 1e-8
@@ -50,19 +56,25 @@ class MaterialGroup:
         return t.apply(self.idx, sigma, d, mode) if t is not None else 0
 
 
-class Correspondence:
+class Correspondence(Model):
+    name = "correspondence"
+
     def __init__(self, points, families, materials: dict, material_names, hourglass: float,
-                 contact: bool = False, viscosity=None, tl=None):
+                 mode, contact: bool = False, viscosity=None, tl=None):
+        """``mode``: the State's failure flags (the materials and the tension model
+        set them; failed points carry no stress)."""
         n, nl = points.n_owned, points.n_local
         self.points = points
         self.families = families
+        self.mode = mode
         mats = [materials[m] for m in material_names]
         self.materials = mats                   # by material id, on every rank
-        self.groups = []                        # the materials with points on this rank
+        self.groups = []                        # the solids with points on this rank
         for mid, mat in enumerate(mats):
             idx = np.nonzero(points.material[:n] == mid)[0]
-            if len(idx):
+            if len(idx) and mat.family == "tl":
                 self.groups.append(MaterialGroup(mat, idx, mid))
+        self.interface = None                   # the ghost-force correction, if any
         eye = np.broadcast_to(np.eye(3), (n, 3, 3))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
@@ -90,7 +102,8 @@ class Correspondence:
             K = np.array([m.bulk_modulus for m in mats])[points.material[:n]]
             self.visc_l = viscosity.cl * rho * np.sqrt(K / rho)        # C_l rho0 c0
             self.visc_q = viscosity.cq * rho                           # C_q rho0
-        self.hg_modulus = np.array([hourglass * m.hourglass_modulus for m in mats])[
+        self.hg_modulus = np.array([hourglass * m.hourglass_modulus if m.family == "tl" else 0.0
+                                    for m in mats])[
             points.material[:n]]
         # bond-spring constant 18 k / (pi delta^4) of every local point
         bulk = np.array([m.bulk_modulus for m in mats])[points.material]
@@ -99,12 +112,12 @@ class Correspondence:
         # points outside the total-Lagrangian model (the gas): code NOT_TL, never counted
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
 
-    def register(self, state, mode):
-        """This model's arrays in the State (owner "correspondence"), each material
-        group's history as ``state<material id>/<name>`` on every rank (an empty
+    def register(self, state):
+        """This model's arrays in the State (owner "correspondence"), each solid
+        material's history as ``state<material id>/<name>`` on every rank (an empty
         subset where a rank has no point of that material), and the output fields
-        computed from them.  ``mode``: the State's failure flags."""
-        own = "correspondence"
+        computed from them."""
+        own, mode = self.name, self.mode
         add = state.add
         for name in ("Kinv", "trK", "Fdot", "d", "J", "J_end", "toggled", "gamma", "dil",
                      "hg_modulus"):
@@ -123,6 +136,8 @@ class Correspondence:
             add("visc_q", own, self.visc_q)
         here = {g.mid: g for g in self.groups}
         for mid, mat in enumerate(self.materials):
+            if mat.family != "tl":
+                continue
             g = here.get(mid)
             rows = g.idx if g is not None else np.zeros(0, np.int64)
             hist = g.state if g is not None else mat.new_state(0)
@@ -135,7 +150,12 @@ class Correspondence:
         state.offer("stress", own, self.cauchy_stress)
         state.offer("elastic_energy", own, lambda: self.elastic_energy(mode))
 
-    def after_restore(self):
+    def attach_interface(self, correction):
+        """The ghost-force correction (mpipd.model.interface) becomes the last part
+        of :meth:`gather`."""
+        self.interface = correction
+
+    def after_restore(self, halo=None):
         """Shape tensors from the restored bonds (restart step 2)."""
         self.rebuild_shape()
 
@@ -179,6 +199,12 @@ class Correspondence:
         """Owned total-Lagrangian points on the bond-spring fallback."""
         return int(np.count_nonzero((self.spring == SPRING_K) | (self.spring == SPRING_F)))
 
+    def update(self, u, v, dt: float, t: float):
+        """F and Fdot, then rotation, stretch and d, then the materials' stress."""
+        self.deform(u, v)
+        self.rotate(dt)
+        self.update_stress(dt, self.mode)
+
     def deform(self, u, v):
         p, fam = self.points, self.families
         nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets,
@@ -206,9 +232,10 @@ class Correspondence:
         """Tension failure model (Eqs. 37–38) of the materials that have one."""
         return sum(g.check_tension(self.sigma, self.d, mode) for g in self.groups)
 
-    def force_data(self) -> np.ndarray:
-        """Force data of the owned points; returns the points that switched to or
-        from the singular-F fallback (SPRING_F) in this call."""
+    def force_data(self, u, ledger=None) -> tuple:
+        """Force data of the owned points (returned for the halo).  A point that
+        switched to or from the singular-F fallback (SPRING_F) in this call changes
+        its held potentials discontinuously: the ledger books before - after."""
         n_bad, n_tog = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK,
                                        self.spring, self.hg_modulus, self.Jfac, self.fd,
                                        self.toggled)
@@ -217,13 +244,27 @@ class Correspondence:
                            self.visc_l, self.visc_q, self.fd)
         if n_bad or n_tog:
             self.n_spring = self.count_spring()
-        return self.toggled[:n_tog]
+        if n_tog and ledger is not None:
+            self._book_toggles(self.toggled[:n_tog], u, ledger)
+        return (self.fd,)
+
+    def _book_toggles(self, rows, u, ledger):
+        """Potentials of ``rows`` under their other fallback code (before the
+        switch) and under the current one: the jump the switch made."""
+        now = self.spring[rows].copy()
+        self.spring[rows] = np.where(now == SPRING_F, CORRESPONDENCE, SPRING_F).astype(np.uint8)
+        before = self.potentials(rows, u)
+        self.spring[rows] = now
+        ledger.book_jump(before, self.potentials(rows, u))
 
     def gather(self, u, v, f, fv):
-        """Internal force density into f; the viscous share also into fv (if any)."""
+        """Internal force density into f, the viscous share also into fv (if any);
+        then the ghost-force correction f_i -= P_i g_i where there is one."""
         p, fam = self.points, self.families
         nosb.gather_forces(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
                            fam.broken, self.fd, self.cbb, self.contact, f, fv)
+        if self.interface is not None:
+            self.interface.apply(self.fd, self.F, f)
 
     def commit(self):
         self.F_old[...] = self.F

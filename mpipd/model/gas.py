@@ -16,6 +16,9 @@ material.
   eligible point has moved more than half the skin since: until then every pair
   within the horizon is in the list.  The kernels keep only pairs inside the
   horizon, in gid order, so the result is exactly that of a search every step.
+* It is the "ul" model family (:class:`mpipd.model.base.Model`): ``update`` moves
+  the families, volume, energy and pressure on; ``force_data`` hands the halo the
+  force data ``gd`` that ``update`` made; ``gather`` adds the pair forces.
 * Kernels: mpipd.kernels.ul.  The gas energy (per initial volume) changes by
   exactly the trapezoidal work of the gas's forces; it is the ledger's ``gas``.
 """
@@ -29,13 +32,16 @@ from scipy.spatial import cKDTree
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.ul import gas_gather, gas_update
 from ..state import AUX, LOCAL
+from .base import Model
 from .families import _csr_by_row
 
 #: Verlet skin of the gas families, as a fraction of the gas horizon
 SKIN = 0.2
 
 
-class Gas:
+class Gas(Model):
+    name = "gas"
+
     def __init__(self, scene, points, team):
         """The gas of ``scene`` among this rank's ``points`` (collective: the search
         reach is the largest gas horizon over all ranks)."""
@@ -81,7 +87,7 @@ class Gas:
         before: volume, pressure and last force state (columns of ``gd``), the last
         step's pair weights and the energy per initial volume; the gas pressure is
         offered as (its part of) the output field ``pressure``."""
-        own, gd = "gas", self.gd
+        own, gd = self.name, self.gd
         add = state.add
         add("gd", own, gd, rows=LOCAL, exchanged=True)
         add("gas_V", own, gd[:, GD_V], rows=LOCAL, checkpoint=True)
@@ -152,7 +158,11 @@ class Gas:
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
 
-    def gather(self, u, f):
+    def force_data(self, u, ledger=None) -> tuple:
+        """The owned gas's force data, made by :meth:`update` (gd: A, V, p)."""
+        return (self.gd,)
+
+    def gather(self, u, v, f, fv=None):
         """UL forces into f; u must be the displacement update() last saw."""
         p = self.points
         y = self.y if self.y is not None else p.x + u

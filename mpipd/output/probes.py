@@ -147,6 +147,8 @@ class Probes:
     def _strength(self, i) -> float:
         """The material's strength at point i (Material.point_strength: NaN for a
         material without one), 0 once the point has failed."""
+        if i not in self._group:                # a gas point: no strength model
+            return math.nan
         g, pos = self._group[i]
         s = g.material.point_strength(g.state, pos)
         return s if math.isnan(s) or self.mode[i] == 0 else 0.0
