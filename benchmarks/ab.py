@@ -5,7 +5,9 @@
 
 For each case and rank count, runs benchmarks/case.py of OLD and of NEW
 alternately (``repeat`` times each, so drifts of this noisy machine hit both),
-and prints per case the best bond-steps/s per core of each and NEW/OLD - 1.
+and prints per case the best and the median bond-steps/s per core of each, and
+NEW/OLD - 1 of the best (the machine's noise only ever slows a run; the medians show
+how large it was).
 Each checkout is imported with this interpreter (the same venv for both) through
 benchmarks/checkout_run.py, which sets the editable install's finder aside (with
 PYTHONPATH alone both runs would import the installed tree).
@@ -13,6 +15,7 @@ PYTHONPATH alone both runs would import the installed tree).
 import argparse
 import os
 import re
+import statistics
 import subprocess
 import sys
 from pathlib import Path
@@ -44,7 +47,8 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=20)
     ap.add_argument("--repeat", type=int, default=2)
     a = ap.parse_args()
-    print(f"{'case':14s} {'ranks':>5s} {'old M/core':>11s} {'new M/core':>11s} {'new/old-1':>9s}")
+    print(f"{'case':14s} {'ranks':>5s} {'old best':>9s} {'new best':>9s} {'new/old-1':>9s} "
+          f"{'old median':>10s} {'new median':>10s}   (M bond-steps/s per core, {a.repeat} runs each)")
     for case in a.cases.split(","):
         for n in map(int, a.ranks.split(",")):
             old, new = [], []
@@ -52,7 +56,8 @@ def main() -> int:
                 old.append(run_case(a.old.resolve(), case, n, a.size, a.steps))
                 new.append(run_case(a.new.resolve(), case, n, a.size, a.steps))
             o, w = max(old), max(new)
-            print(f"{case:14s} {n:5d} {o / 1e6:11.2f} {w / 1e6:11.2f} {w / o - 1:+9.1%}",
+            print(f"{case:14s} {n:5d} {o / 1e6:9.2f} {w / 1e6:9.2f} {w / o - 1:+9.1%} "
+                  f"{statistics.median(old) / 1e6:10.2f} {statistics.median(new) / 1e6:10.2f}",
                   flush=True)
     return 0
 

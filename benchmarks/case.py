@@ -140,6 +140,7 @@ def main():
     team.barrier()
     failed0 = int(sim.failure_counts()[1:].sum())
     book0 = sim.failure.seconds if sim.failure else 0.0
+    flags0 = sim.failure.exchange_seconds if sim.failure else 0.0
     if sim.gas is not None:
         sim.gas.search_seconds = 0.0
     t0 = time.perf_counter()
@@ -153,10 +154,12 @@ def main():
                   f" gas_research_share={share:.3f}")
     if sim.failure is not None:
         book = team.max(sim.failure.seconds - book0)
+        flags = team.max(sim.failure.exchange_seconds - flags0)
         failed = int(sim.failure_counts()[1:].sum())
         per100 = (failed - failed0) / sim.n_global * 100.0 / args.steps * 100.0
         extra += (f" failed_pct_per_100_steps={per100:.3f} failed_total={failed}"
-                  f" bonds_broken={sim.bonds_broken()} breakage_share={book / wall:.3f}")
+                  f" bonds_broken={sim.bonds_broken()} breakage_share={book / wall:.3f}"
+                  f" flag_exchange_share={flags / wall:.3f}")
     if sim.interface is not None:               # the ghost-force correction's own cost
         ic = sim.interface
         t1 = time.perf_counter()

@@ -96,6 +96,28 @@ def test_jwl_pressure_at_unreacted_density(team):
     np.testing.assert_allclose(p, want, rtol=1e-12)
 
 
+def test_the_gas_is_its_own_model_family(team):
+    """The explosive is the "ul" model (mpipd.model.gas), built from the scene beside
+    the correspondence solids: no material group, history or stress update of the
+    correspondence machinery holds it, and its points carry the NOT_TL code."""
+    from mpipd.kernels.layout import NOT_TL
+    from mpipd.model.correspondence import Correspondence
+    from mpipd.model.gas import Gas
+    scene, _ = sc.load("detonation_tube", ["parts.2.shape.radius=0.005"])
+    sim = Simulation(scene, team)
+    assert [type(m) for m in sim.models] == [Correspondence, Gas] and sim.gas is sim.models[1]
+    names = list(scene.materials)
+    ex = names.index("explosive")
+    assert ex not in {g.mid for g in sim.corr.groups}
+    assert not any(k.startswith(f"state{ex}/") for k in sim.state.fields)
+    n = sim.points.n_owned
+    assert np.all(sim.corr.spring[sim.gas.gas_idx] == NOT_TL)
+    assert len(sim.gas.gas_idx) == np.count_nonzero(sim.points.material[:n] == ex)
+    # a scene without an explosive builds the solids' model alone
+    solid, _ = sc.load("granite_ring", [])
+    assert [type(m) for m in Simulation(solid, team).models] == [Correspondence]
+
+
 def test_gas_has_no_bonds_and_does_not_touch_rock(team):
     scene, _ = sc.load("detonation_tube", ["parts.2.shape.radius=0.005"])
     sim = Simulation(scene, team)

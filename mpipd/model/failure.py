@@ -53,7 +53,11 @@ class Failure:
         self.reach = float(points.horizon.max()) if nl else 0.0
         self.ledger = ledger
         self.bonds_broken = 0
-        self.seconds = 0.0                      # wall time spent here (bookkeeping share)
+        # wall time of update(): the bookkeeping (search, breakage, rebuild, damage),
+        # and the flag exchange apart, since on several ranks the exchange is the
+        # first wait after the step's work and absorbs the ranks' imbalance
+        self.seconds = 0.0
+        self.exchange_seconds = 0.0
         self.refresh_damage()
 
     def register(self, state):
@@ -77,6 +81,8 @@ class Failure:
         Returns the newly failed local points."""
         t0 = time.perf_counter()
         self.halo.exchange(self.mode)
+        t1 = time.perf_counter()
+        self.exchange_seconds += t1 - t0
         new = np.flatnonzero((self.mode != 0) & (self.done == 0))
         if len(new):
             self.done[new] = 1
@@ -98,7 +104,7 @@ class Failure:
                 pd_damage(changed, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
                 if self.damping > 0:
                     self.damp[changed] = np.where(self.phi[changed] >= 1.0, self.damping, 0.0)
-        self.seconds += time.perf_counter() - t0
+        self.seconds += time.perf_counter() - t1
         return len(new)
 
     def refresh_damage(self):
