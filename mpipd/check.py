@@ -46,7 +46,7 @@ BYTES_PER_LOCAL_POINT = 210     # x, gid, part, material, volume, horizon, dx, i
 BYTES_PER_OWNED_POINT = 666     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
 #                                 index, volume factor, fallback toggles, ledger row index
-BYTES_PER_BOND = 5              # nbr (int32) + broken (uint8)
+BYTES_PER_BOND = 21             # nbr (int32) + broken (uint8) + omega_i, omega_j (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
 VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 72   # fd columns; dilatation, viscous force (2 steps)

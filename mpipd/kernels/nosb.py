@@ -118,10 +118,29 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
 
 
 @numba.njit(cache=True)
-def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kinv, spring, F,
-                          Fdot, dil):
-    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v.  If ``dil``
-    has rows, also dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
+def bond_influence(x, horizon, infl, offsets, nbr, wi, wj):
+    """Both ends' influence of every bond b = (i, j) of the reference configuration:
+    wi[b] = omega_i(|xi|) (point i's function and horizon), wj[b] = omega_j(|xi|).
+    They depend on reference positions only, so they are computed once; the hot
+    kernels read them instead of evaluating |xi| and omega each step (the same
+    numbers, so the same results)."""
+    n = offsets.shape[0] - 1
+    for i in range(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            wi[b] = influence(infl[i], horizon[i], r)
+            wj[b] = influence(infl[j], horizon[j], r)
+
+
+@numba.njit(cache=True)
+def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, F, Fdot, dil):
+    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v (``wi``: the
+    bonds' omega_i, :func:`bond_influence`).  If ``dil`` has rows, also
+    dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
     want_dil = dil.shape[0] > 0
     n = offsets.shape[0] - 1
     N = np.empty((3, 3))
@@ -139,8 +158,6 @@ def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kin
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
         vi0, vi1, vi2 = v[i, 0], v[i, 1], v[i, 2]
-        di = horizon[i]
-        ci = infl[i]
         for b in range(offsets[i], offsets[i + 1]):
             if broken[b]:
                 continue
@@ -148,8 +165,7 @@ def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kin
             e0 = x[j, 0] - xi0
             e1 = x[j, 1] - xi1
             e2 = x[j, 2] - xi2
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            w = influence(ci, di, r) * vol[j]
+            w = wi[b] * vol[j]
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
@@ -178,7 +194,7 @@ def deformation_gradients(x, u, v, vol, horizon, infl, offsets, nbr, broken, Kin
             m21 += z2 * e1
             m22 += z2 * e2
             if want_dil:
-                acc += (z0 * e0 + z1 * e1 + z2 * e2) / r
+                acc += (z0 * e0 + z1 * e1 + z2 * e2) / math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         if want_dil:
             dil[i] = acc
         N[0, 0], N[0, 1], N[0, 2] = n00, n01, n02
@@ -288,8 +304,9 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
 
 
 @numba.njit(cache=True)
-def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, contact, f, fv):
-    """Internal force density f (N/m^3) of every owned point (see module docstring).
+def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv):
+    """Internal force density f (N/m^3) of every owned point (see module docstring);
+    ``wi``, ``wj``: the bonds' omega_i and omega_j (:func:`bond_influence`).
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
@@ -306,7 +323,6 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
         b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
         hi = fd[i, FD_H]
         di = horizon[i]
-        ci = infl[i]
         si = fd[i, FD_SPRING]
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
@@ -318,9 +334,11 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            # |xi| only where a term needs it (the viscosity, a spring, contact)
+            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) if visc else 0.0
             if broken[k]:
                 if contact:
+                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                     g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
                                       0.5 * (di + horizon[j]))
                     vj = vol[j]
@@ -329,28 +347,30 @@ def gather_forces(x, u, v, vol, horizon, infl, offsets, nbr, broken, fd, cbb, co
                     fz += g * y2 * vj
                 continue
             tx = ty = tz = 0.0
-            wi = influence(ci, di, r)
-            if wi > 0.0:
+            w_i = wi[k]
+            if w_i > 0.0:
                 if si == 0.0:
-                    tx = wi * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
-                    ty = wi * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
-                    tz = wi * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
+                    tx = w_i * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
+                    ty = w_i * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
+                    tz = w_i * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
                 else:
+                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                     g = _spring(cbb[i], r, y0, y1, y2)
                     tx, ty, tz = g * y0, g * y1, g * y2
-            wj = influence(infl[j], horizon[j], r)
-            if wj > 0.0:
+            w_j = wj[k]
+            if w_j > 0.0:
                 if fd[j, FD_SPRING] == 0.0:
-                    tx += wj * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, FD_H] * y0)
-                    ty += wj * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, FD_H] * y1)
-                    tz += wj * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, FD_H] * y2)
+                    tx += w_j * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, FD_H] * y0)
+                    ty += w_j * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, FD_H] * y1)
+                    tz += w_j * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, FD_H] * y2)
                 else:
+                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                     g = _spring(cbb[j], r, y0, y1, y2)
                     tx += g * y0
                     ty += g * y1
                     tz += g * y2
             if visc:
-                c = viscous_bond(wi, wj, fd[i, FD_VISC_L], fd[i, FD_VISC_Q], fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
+                c = viscous_bond(w_i, w_j, fd[i, FD_VISC_L], fd[i, FD_VISC_Q], fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
                                  v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
                                  e0, e1, e2, r)
                 cv = c * vol[j]

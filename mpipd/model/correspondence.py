@@ -32,7 +32,7 @@ from ..kernels import energy, integrate, nosb, rotation
 from ..kernels.layout import CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F, SPRING_K
 from ..kernels.viscosity import viscosity_data
 from ..materials.base import STATE_OUTPUTS
-from ..state import AUX, LAST, LOCAL, REBUILT
+from ..state import AUX, BOND, LAST, LOCAL, REBUILT
 from .base import Model
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
@@ -75,6 +75,11 @@ class Correspondence(Model):
             if len(idx) and mat.family == "tl":
                 self.groups.append(MaterialGroup(mat, idx, mid))
         self.interface = None                   # the ghost-force correction, if any
+        # both ends' influence omega(|xi|) of every bond (reference geometry: once)
+        self.omega_i = np.empty(len(families.nbr))
+        self.omega_j = np.empty(len(families.nbr))
+        nosb.bond_influence(points.x, points.horizon, points.influence, families.offsets,
+                            families.nbr, self.omega_i, self.omega_j)
         eye = np.broadcast_to(np.eye(3), (n, 3, 3))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
@@ -129,6 +134,8 @@ class Correspondence(Model):
             add(name, own, getattr(self, name), checkpoint=True)
         add("W", own, self.W, checkpoint=True, output="stress_work")
         add("fd", own, self.fd, rows=LOCAL, exchanged=True)
+        add("omega_i", own, self.omega_i, rows=BOND)
+        add("omega_j", own, self.omega_j, rows=BOND)
         add("cbb", own, self.cbb, rows=LOCAL)
         add("not_tl", own, self.not_tl, rows=AUX)
         if self.viscosity is not None:
@@ -207,9 +214,9 @@ class Correspondence(Model):
 
     def deform(self, u, v):
         p, fam = self.points, self.families
-        nosb.deformation_gradients(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets,
-                                   fam.nbr, fam.broken, self.Kinv, self.spring, self.F,
-                                   self.Fdot, self.dil)
+        nosb.deformation_gradients(p.x, u, v, p.volume, self.omega_i, fam.offsets, fam.nbr,
+                                   fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
+                                   self.dil)
 
     def initial_volume(self):
         """J_end = c det F of the current F (the start of a run, before any step)."""
@@ -261,8 +268,9 @@ class Correspondence(Model):
         """Internal force density into f, the viscous share also into fv (if any);
         then the ghost-force correction f_i -= P_i g_i where there is one."""
         p, fam = self.points, self.families
-        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
-                           fam.broken, self.fd, self.cbb, self.contact, f, fv)
+        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
+                           fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact, f,
+                           fv)
         if self.interface is not None:
             self.interface.apply(self.fd, self.F, f)
 
