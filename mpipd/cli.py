@@ -264,10 +264,14 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     wall = 0.0
 
     def segment():
+        """This invocation's record (collective).  Every rank must write the same
+        attribute: the loop's wall time is the slowest rank's (each rank's own
+        differed, and ranks writing different strings corrupted ``segments``)."""
         done = sim.step_count - first
+        w = team.max(wall)
         return {"from_step": first, "to_step": sim.step_count, "ranks": team.size,
-                "wall_s": round(wall, 3),
-                "bond_steps_per_s": sim.n_bonds_global * done / wall if wall > 0 else None}
+                "wall_s": round(w, 3),
+                "bond_steps_per_s": sim.n_bonds_global * done / w if w > 0 else None}
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
                        checkpointer=checkpointer)

@@ -2,6 +2,7 @@
 different number of ranks, and get the uninterrupted run's fields bit for bit.
 The stop (step 230) falls in a step where bonds break, so the checkpoint must
 carry the previous F (from the shape tensors before that breakage)."""
+import json
 import shutil
 
 import h5py
@@ -50,6 +51,12 @@ def test_restart_same_and_different_rank_count(tmp_path, reference):
         assert len(reference["probe_lines"]) == 2
         with h5py.File(d / "run.h5", "r") as f:
             assert f.attrs["bonds_broken"] == reference["broken"]
+            # each invocation's record, written collectively with one value on every
+            # rank (ranks' own wall times once gave a corrupt JSON string)
+            segs = json.loads(f.attrs["segments"])
+            assert [(s["from_step"], s["to_step"], s["ranks"]) for s in segs] == \
+                [(0, 230, 2), (230, int(f.attrs["steps"]), n)]
+            assert all(s["wall_s"] > 0 and s["bond_steps_per_s"] > 0 for s in segs)
             for k in KEYS:
                 assert np.array_equal(f[k][...], reference[k]), f"{k} differs after restart on {n}"
 
