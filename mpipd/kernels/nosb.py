@@ -128,11 +128,7 @@ def bond_influence(x, horizon, infl, offsets, nbr, wi, wj):
     for i in range(n):
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
-            e0 = x[j, 0] - x[i, 0]
-            e1 = x[j, 1] - x[i, 1]
-            e2 = x[j, 2] - x[i, 2]
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            wi[b] = influence(infl[i], horizon[i], r)
+            r, wi[b] = bond(x, i, j, infl[i], horizon[i])[3:]
             wj[b] = influence(infl[j], horizon[j], r)
 
 
