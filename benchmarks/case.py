@@ -164,7 +164,7 @@ def main():
         ic = sim.interface
         t1 = time.perf_counter()
         for _ in range(args.steps):
-            ic.apply(sim.corr.fd, sim.corr.F, sim.f)
+            ic.apply(sim.corr.fd, sim.corr.F, sim.f, sim.classes.klass, sim.classes.level)
         share = team.max(time.perf_counter() - t1) / wall
         extra += (f" interface_points_pct={100.0 * team.sum(len(ic.idx)) / sim.n_global:.2f}"
                   f" interface_share={share:.4f}")

@@ -161,17 +161,17 @@ def layer_bonds(scene, table) -> np.ndarray:
 
 def wave_speed_limit(mat, c_max: float):
     """Smallest compression mu in (0, 1] where a JH2 EOS's P-wave speed
-    (:func:`jh2_speed`) reaches c_max; None if it never does, or for other materials."""
+    (``JH2.p_wave_speed_at``) reaches c_max; None if it never does, or for other materials."""
     if not hasattr(mat, "K3"):
         return None
     mus = np.linspace(0.0, 1.0, 20001)
-    above = np.flatnonzero(jh2_speed(mat, mus) >= c_max)
+    above = np.flatnonzero(mat.p_wave_speed_at(mus) >= c_max)
     if not len(above) or above[0] == 0:
         return None
     lo, hi = float(mus[above[0] - 1]), float(mus[above[0]])
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if jh2_speed(mat, mid) >= c_max else (mid, hi)
+        lo, hi = (lo, mid) if float(mat.p_wave_speed_at(mid)) >= c_max else (mid, hi)
     return hi
 
 
@@ -228,7 +228,7 @@ def check_report(scene, ranks: int) -> str:
         out.append(line)
         mu = wave_speed_limit(mat, c_max)
         if mu is not None:
-            c_far = jh2_speed(mat, MU_FAR)
+            c_far = float(mat.p_wave_speed_at(MU_FAR))
             out.append(f"      EOS stiffening: the P-wave speed sqrt(((1+mu)^2 dp/dmu + 4G/3)/rho) passes "
                        f"{c_max:.1f} m/s at mu = {mu:.4g}; beyond, dt is above the critical step "
                        f"(at mu = {MU_FAR:g}: {c_far:.0f} m/s, dt <= {dt_c * c_p / c_far:.3e} s "
@@ -294,13 +294,3 @@ def check_report(scene, ranks: int) -> str:
 #: the "far beyond the negative-dp/dmu range" compression the report quotes (K3 mu^3 dominates)
 MU_FAR = 0.1
 
-
-def jh2_speed(mat, mu):
-    """P-wave speed of a JH2 EOS at compression mu, in the reference configuration the
-    solver integrates in: the bulk stiffness is J dp/dJ = (1 + mu)^2 dp/dmu, the density
-    rho0.  (Measured critical steps of a confined block at mu = 0.02 and 0.1 follow it
-    within 5 %, once the EOS is evaluated at the end-of-step J.)"""
-    mu = np.asarray(mu, dtype=float)
-    k = (1.0 + mu) ** 2 * (mat.bulk_modulus + 2.0 * mat.K2 * mu + 3.0 * mat.K3 * mu * mu)
-    c = np.sqrt(np.maximum(k + 4.0 * mat.shear_modulus / 3.0, 0.0) / mat.density)
-    return float(c) if c.ndim == 0 else c

@@ -39,6 +39,7 @@ from .model.gas import Gas
 from .model.interface import InterfaceCorrection
 from .model.interface import needed as interface_needed
 from .model.ledger import Energies, Ledger
+from .model.multirate import StepClasses
 from .output.peaks import Peaks
 from .output.probes import Probes
 from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
@@ -100,9 +101,12 @@ class Simulation:
         self.v[:n][self.fixed.astype(bool)] = 0.0
 
         sv = scene.solver
+        # step classes (multi-rate; all 0 in a single-rate scene)
+        self.classes = StepClasses(scene, p, self.families, self.tl)
+        self.classes.register(st)
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
-                                   self.mode, contact=sv.contact, viscosity=sv.viscosity,
-                                   tl=self.tl)
+                                   self.mode, self.classes, contact=sv.contact,
+                                   viscosity=sv.viscosity, tl=self.tl)
         self.corr.register(st)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
         # the ghost-force correction exists only where dx or the horizon changes
@@ -149,6 +153,7 @@ class Simulation:
         self.t = 0.0
         self.peaks = Peaks(self, scene.output)
         self.peaks.register(st)
+        self.classify()                         # the reference state's classes
         self.initialize()
         self.probes = (Probes(scene.probes, scene, p, team, self.corr, self.v, self.mode)
                        if scene.probes else None)
@@ -163,6 +168,7 @@ class Simulation:
         ledger's initial energy includes it."""
         if getattr(self, "gas", None) is not None:
             self.gas.y = None                   # positions come from u, not a past update
+        self.classes.level = self.classes.top   # a coarse boundary: every state is current
         self.halo.exchange(self.u, self.v)
         self.corr.deform(self.u, self.v)
         if self.step_count == 0:
@@ -188,17 +194,33 @@ class Simulation:
         for m in self.models:
             m.gather(self.u, self.v, self.f, self.ledger.fv)
 
-    def _refresh_forces(self, dt: float):
-        """Forces of the state after this step's breakage, for the next half kick
-        (Solver.refresh_after_break).  The integrator term -(dt^2/8) sum m |a|^2
-        jumps with a; the ledger books the jump like any other discontinuity."""
+    def _refresh_forces(self, dt: float, reclassified: bool = False):
+        """Forces of the state after this step's breakage (Solver.refresh_after_break)
+        or with the step classes' new weights, for the next half kick.  The
+        integrator term -(dt^2/8) sum m |a|^2 jumps with a; the ledger books the
+        jump like any other discontinuity: in ``multirate`` when the classes
+        changed at this boundary, else in ``removed``."""
         before = self.ledger.integrator(self)
         self.compute_forces()
         if self.loads:
             self.apply_loads(self.t + dt, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
         self.ledger.start(self.interface)
-        self.ledger.jumps += before - self.ledger.integrator(self)
+        jump = before - self.ledger.integrator(self)
+        if reclassified:
+            self.ledger.reclass += jump
+        else:
+            self.ledger.jumps += jump
+
+    def classify(self) -> bool:
+        """New step classes from the current state (a coarse boundary; multi-rate
+        only); True, on every rank, if any point's class changed."""
+        if not self.classes.enabled:
+            return False
+        changed = bool(self.team.max(int(self.classes.classify(self.corr, self.halo))))
+        if changed:
+            self.corr.regroup()
+        return changed
 
     def apply_loads(self, t: float, dt: float):
         """Add the loads' body forces at time t to f; accumulate their work over the
@@ -225,22 +247,37 @@ class Simulation:
             m.commit()
 
     def step(self):
+        """One fine step.  With step classes (mpipd.model.multirate) only the states
+        whose class acts at this step's level are updated and gathered; failure,
+        breakage and the new classes wait for the coarse boundary."""
         dt = self.dt
+        cl = self.classes
+        cl.set_level(self.step_count + 1)
         integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed, self.damp,
                              self.ledger.edamp)
         self.update(dt)
         self.ledger.book_work(self.v, self.points.volume, dt, self.interface)
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
         self.peaks.sample(self)
-        if self.failure is not None:                # paper §2.7 steps 11–12
-            self.corr.check_tension(self.mode)
-            new = self.failure.update(self.u)
-            if new and self.interface is not None:
-                self.interface.retire(self.mode)
-            if self.scene.solver.refresh_after_break and self.team.max(int(new > 0)):
-                self._refresh_forces(dt)
+        if cl.boundary(self.step_count + 1):
+            refresh = False
+            if self.failure is not None:            # paper §2.7 steps 11–12
+                self.corr.check_tension(self.mode)
+                new = self.failure.update(self.u)
+                if new and self.interface is not None:
+                    self.interface.retire(self.mode)
+                refresh = bool(self.scene.solver.refresh_after_break
+                               and self.team.max(int(new > 0)))
+            changed = self.classify()
+            if refresh or changed:
+                self._refresh_forces(dt, reclassified=changed)
         self.step_count += 1
         self.t = self.step_count * dt
+
+    @property
+    def at_boundary(self) -> bool:
+        """Is the current step a coarse-step boundary (every state current)?"""
+        return self.classes.boundary(self.step_count)
 
     # ------------------------------------------------------------------ diagnostics
     def energies(self) -> Energies:
@@ -302,6 +339,8 @@ class Simulation:
         """Rebuild, from a restored state, what follows from it: the gas's pair-weight
         ghosts, the shape tensors, the failure flags' ghosts, damage and damped set
         (mpipd.output.checkpoint.restore, step 2)."""
+        self.classes.after_restore(self.halo)
+        self.corr.regroup()
         for m in self.models:
             m.after_restore(self.halo)
         if self.failure is not None:
@@ -350,6 +389,9 @@ class Simulation:
                 self.probes.sample(self.step_count, self.t)
             last = self.step_count == n_steps
             frame = writer is not None and every and (self.step_count % every == 0 or last)
+            if frame and not self.at_boundary:
+                raise RuntimeError(f"frame at step {self.step_count}, not a coarse-step "
+                                   "boundary (the scene check keeps frames on them)")
             if frame or self.step_count % FINITE_CHECK_EVERY == 0:
                 try:
                     self.check_finite()
@@ -359,6 +401,8 @@ class Simulation:
                     raise
             if frame:
                 writer.frame(self)
+            if not self.at_boundary:        # states of coarse classes are mid-step
+                continue
             if progress is not None:
                 progress(self, self.step_count - first, n_steps - first,
                          _time.perf_counter() - t0)

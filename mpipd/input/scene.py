@@ -3,7 +3,8 @@
 A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
 
     [scene]       name, description
-    [time]        dt (s) and exactly one of steps / t_end (s)
+    [time]        dt (s) and exactly one of steps / t_end (s); optionally
+                  multirate = { max_ratio = 4, safety = 0.5 } (mpipd.model.multirate)
     [materials.NAME]  model = "elastic", density, bulk_modulus, shear_modulus
     [[parts]]     name, material, dx (m), horizon_factor (default 3.0),
                   shape = { kind = "box" | "cylinder" | "annulus", ... },
@@ -70,10 +71,33 @@ class Meta:
 
 
 @dataclass(frozen=True)
+class Multirate:
+    """Multi-rate integration (mpipd.model.multirate): every point takes steps of
+    2^k dt, k from its material's stable step at its current state times
+    ``safety``, up to ``max_ratio`` dt (the coarse step: failure, breakage,
+    frames and checkpoints happen every ``max_ratio`` steps)."""
+    max_ratio: int = 4
+    safety: float = 0.5
+
+    def check(self, path):
+        if self.max_ratio not in MAX_RATIOS:
+            fail(join(path, "max_ratio"), "must be one of "
+                 + ", ".join(map(str, MAX_RATIOS)) + f" (a power of two up to {MAX_RATIOS[-1]}, "
+                 f"the ratios the verification covers); got {self.max_ratio}")
+        if not 0.0 < self.safety <= 1.0:
+            fail(join(path, "safety"), f"must be in (0, 1] (got {self.safety})")
+
+
+#: the coarse/fine step ratios multi-rate integration accepts (verified in make verify)
+MAX_RATIOS = (1, 2, 4, 8)
+
+
+@dataclass(frozen=True)
 class Time:
     dt: float
     steps: int | None = None
     t_end: float | None = None
+    multirate: Multirate | None = None
 
     def check(self, path):
         positive(self, path, "dt")
@@ -304,6 +328,14 @@ class Scene:
                                                for p in self.parts):
                 known = ", ".join(p.name for p in self.parts)
                 fail(f"probes[{i}].part", f"no part {pr.part!r} (parts: {known})")
+        mr = self.time.multirate
+        if mr is not None and mr.max_ratio > 1:
+            r = mr.max_ratio
+            for where, n in (("time.steps", self.time.n_steps), ("output.every", self.output.every),
+                             ("output.checkpoint_every", self.output.checkpoint_every)):
+                if n % r:
+                    fail(where, f"must be a multiple of time.multirate.max_ratio = {r} "
+                                f"(got {n}): states are all current only at coarse steps")
         needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
                  "plastic": self.has_model("jh2") or self.has_model("j2"),
                  "pressure": self.has_model("jh2") or self.has_model("jwl")}

@@ -64,19 +64,20 @@ def kick(v, f, rho, dt, fixed, a):
 
 
 @numba.njit(cache=True)
-def stress_power(sigma, d, J, dt, spring, W):
-    """W += dt J sigma : d  (stress work per reference volume, elastic + plastic;
-    P : Fdot = J sigma : D).
+def stress_power(sigma, d, J, dt, spring, W, klass, level):
+    """W += dt_i J sigma : d  (stress work per reference volume, elastic + plastic;
+    P : Fdot = J sigma : D), dt_i = 2^k_i dt, at the points whose step class
+    acts at ``level`` (kernels.classes).
 
     Called with dt/2 before and after the stress update, this is the
     trapezoidal rule on the stress power.
     """
     for i in range(W.shape[0]):
-        if spring[i] != CORRESPONDENCE:
+        if spring[i] != CORRESPONDENCE or klass[i] > level:
             continue
         s = (sigma[i, 0] * d[i, 0] + sigma[i, 1] * d[i, 1] + sigma[i, 2] * d[i, 2]
              + 2.0 * (sigma[i, 3] * d[i, 3] + sigma[i, 4] * d[i, 4] + sigma[i, 5] * d[i, 5]))
-        W[i] += dt * J[i] * s
+        W[i] += dt * float(1 << klass[i]) * J[i] * s
 
 
 @numba.njit(cache=True)

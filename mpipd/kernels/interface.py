@@ -15,6 +15,7 @@ import math
 
 import numba
 
+from .classes import weight
 from .influence import influence
 from .layout import FD_H, FD_SPRING, KINV_FLAG
 
@@ -55,16 +56,21 @@ def interface_vectors(x, vol, horizon, infl, offsets, nbr, broken, kinv, points,
 
 
 @numba.njit(cache=True)
-def subtract_ghost_force(fd, F, idx, q, active, f, fc):
+def subtract_ghost_force(fd, F, idx, q, active, f, fc, klass, level):
     """f_i -= A_i q_i with A_i = B_i + h_i F_i, at the active points ``idx``;
     fc[p] = -A_i q_i, the correction's force density (0 where it does not act),
-    for the energy ledger."""
+    for the energy ledger.  It is part of point i's force state: with step
+    classes it acts with i's weight 2^k_i where i's class acts at ``level``
+    (kernels.classes)."""
     for p in range(idx.shape[0]):
         for r in range(3):
             fc[p, r] = 0.0
         if not active[p]:
             continue
         i = idx[p]
+        ri = weight(klass[i], level)
+        if ri == 0.0:
+            continue
         if fd[i, FD_SPRING] != 0.0:                  # bond-spring fallback this step: no P
             continue
         h = fd[i, FD_H]
@@ -72,6 +78,7 @@ def subtract_ghost_force(fd, F, idx, q, active, f, fc):
             acc = 0.0
             for c in range(3):
                 acc += (fd[i, 3 * r + c] + h * F[i, r, c]) * q[p, c]
+            acc *= ri
             f[i, r] -= acc
             fc[p, r] = -acc
 

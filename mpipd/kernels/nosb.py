@@ -36,6 +36,7 @@ import math
 import numba
 import numpy as np
 
+from .classes import weight
 from .contact import contact_force
 from .influence import influence
 from .layout import (
@@ -133,8 +134,10 @@ def bond_influence(x, horizon, infl, offsets, nbr, wi, wj):
 
 
 @numba.njit(cache=True)
-def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, F, Fdot, dil):
-    """F (Eq. 5) and Fdot (Eq. 13) of every owned point, from u and v (``wi``: the
+def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, F, Fdot, dil,
+                          klass, level):
+    """F (Eq. 5) and Fdot (Eq. 13) of every owned point whose step class
+    ``klass[i]`` acts at ``level`` (kernels.classes), from u and v (``wi``: the
     bonds' omega_i, :func:`bond_influence`).  If ``dil`` has rows, also
     dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
     want_dil = dil.shape[0] > 0
@@ -142,6 +145,8 @@ def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, 
     N = np.empty((3, 3))
     Nd = np.empty((3, 3))
     for i in range(n):
+        if klass[i] > level:
+            continue
         if spring[i] == SPRING_K or spring[i] == NOT_TL:         # no F
             for r in range(3):
                 for c in range(3):
@@ -243,7 +248,7 @@ def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spr
 
 
 @numba.njit(cache=True)
-def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
+def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, klass, level):
     """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
     fd[i, FD_H] = h, fd[i, FD_SPRING] = 1.0 for a bond-spring point, else 0.0, with
     A = c J sigma F^-T K^-1 (J = det F, c = Jfac[i] the volume factor),
@@ -254,7 +259,9 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
     fallback; so, for this step only, does a point whose F is singular or not
     finite (``spring[i] = SPRING_F``, re-tested every step).  The points that switched
     between 0 and 2 in this call are written to ``toggled`` (their energy is
-    booked by the ledger).  Returns (points on SPRING_F, points toggled).
+    booked by the ledger).  Only points whose class acts at ``level``
+    (kernels.classes) are evaluated; the others keep their last force data.
+    Returns (points on SPRING_F, points toggled).
     """
     n_owned = F.shape[0]
     S = np.empty((3, 3))
@@ -265,6 +272,8 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
     n_bad = 0
     n_tog = 0
     for i in range(n_owned):
+        if klass[i] > level:
+            continue
         if spring[i] == CORRESPONDENCE or spring[i] == SPRING_F:      # F exists
             was = spring[i]
             J = det3(F[i])
@@ -300,7 +309,8 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled):
 
 
 @numba.njit(cache=True)
-def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv):
+def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv,
+                  klass, kmin, level):
     """Internal force density f (N/m^3) of every owned point (see module docstring);
     ``wi``, ``wj``: the bonds' omega_i and omega_j (:func:`bond_influence`).
 
@@ -308,10 +318,25 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
     (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, FD_VISC_L], fd[:, FD_VISC_Q] and v; its
     share of f is also written to ``fv`` (for the energy ledger's viscous work).
+
+    Multi-rate (kernels.classes): each point's state enters with its weight
+    2^k_i if its class acts at ``level``, else 0 (so f is the impulse of the
+    step over dt); a broken pair's contact, a pair force, with the weight of the
+    pair's finer class.  Both ends of a bond see the same weights, so every
+    bond's impulses are equal and opposite.  A point whose closed family has
+    no class acting (``kmin[i] > level``) gets f = 0.
     """
     n = offsets.shape[0] - 1
     visc = fd.shape[1] > 11
     for i in range(n):
+        if kmin[i] > level:
+            for c in range(3):
+                f[i, c] = 0.0
+                if visc:
+                    fv[i, c] = 0.0
+            continue
+        ki = klass[i]
+        ri = weight(ki, level)
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
         b0, b1, b2 = fd[i, 0], fd[i, 1], fd[i, 2]
@@ -332,18 +357,22 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
             y2 = e2 + (u[j, 2] - ui2)
             # |xi| only where a term needs it (the viscosity, a spring, contact)
             r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) if visc else 0.0
+            kj = klass[j]
             if broken[k]:
-                if contact:
+                if contact and min(ki, kj) <= level:
                     r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                     g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
-                                      0.5 * (di + horizon[j]))
+                                      0.5 * (di + horizon[j])) * weight(min(ki, kj), level)
                     vj = vol[j]
                     fx += g * y0 * vj
                     fy += g * y1 * vj
                     fz += g * y2 * vj
                 continue
+            rj = weight(kj, level)
+            if ri == 0.0 and rj == 0.0:
+                continue
             tx = ty = tz = 0.0
-            w_i = wi[k]
+            w_i = wi[k] * ri
             if w_i > 0.0:
                 if si == 0.0:
                     tx = w_i * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
@@ -351,9 +380,9 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
                     tz = w_i * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
                 else:
                     r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    g = _spring(cbb[i], r, y0, y1, y2)
+                    g = _spring(cbb[i], r, y0, y1, y2) * ri
                     tx, ty, tz = g * y0, g * y1, g * y2
-            w_j = wj[k]
+            w_j = wj[k] * rj
             if w_j > 0.0:
                 if fd[j, FD_SPRING] == 0.0:
                     tx += w_j * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, FD_H] * y0)
@@ -361,7 +390,7 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
                     tz += w_j * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, FD_H] * y2)
                 else:
                     r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    g = _spring(cbb[j], r, y0, y1, y2)
+                    g = _spring(cbb[j], r, y0, y1, y2) * rj
                     tx += g * y0
                     ty += g * y1
                     tz += g * y2

@@ -27,8 +27,9 @@ from .linalg import det3, inv3, mat_to_voigt, mul3, mul3_at
 
 
 @numba.njit(cache=True)
-def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
-    """Advance R and V of every owned point by dt; write d (Voigt), J = c det F_mid
+def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac, klass, level):
+    """Advance R and V of every owned point whose step class acts at ``level``
+    (kernels.classes) by its step dt_i = 2^k_i dt; write d (Voigt), J = c det F_mid
     (for the stress power and the viscosity, which live at mid-step) and
     J_end = c det F_{n+1}: the volume the new stress acts on, from which a
     total-volume EOS (JH2's mu = 1/J - 1) must take its pressure.  Taking it
@@ -37,7 +38,12 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
 
     c = ``Jfac[i]`` is the point's volume factor (1 until its shape tensor is
     rebuilt after bonds broke; see Correspondence.rebuild_shape): the volume
-    ratio of the point is c det F, continuous across a change of family."""
+    ratio of the point is c det F, continuous across a change of family.
+
+    A point of a coarse class (k_i > 0) takes Fdot = (F_{n+1} - F_n) / dt_i,
+    the mean rate over its own step (its neighbours of finer classes moved at
+    several speeds within it); class 0 keeps Fdot of Eq. 13 from the mid-step
+    velocities, which is the same for a family of one class."""
     n = F_new.shape[0]
     Fm = np.empty((3, 3))
     Fi = np.empty((3, 3))
@@ -51,6 +57,14 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
     Dm = np.empty((3, 3))
     Vn = np.empty((3, 3))
     for i in range(n):
+        k = klass[i]
+        if k > level:
+            continue
+        h = dt * float(1 << k)
+        if k > 0:
+            for r in range(3):
+                for c in range(3):
+                    Fdot[i, r, c] = (F_new[i, r, c] - F_old[i, r, c]) / h
         for r in range(3):
             for c in range(3):
                 Fm[r, c] = 0.5 * (F_old[i, r, c] + F_new[i, r, c])
@@ -97,16 +111,16 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac):
         mul3(V[i], Om, M)
         for r in range(3):
             for c in range(3):
-                Vn[r, c] = V[i, r, c] + dt * (T[r, c] - M[r, c])
+                Vn[r, c] = V[i, r, c] + h * (T[r, c] - M[r, c])
         # R_{n+1} = exp(dt Omega) R_n
         a = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-        th = a * dt
+        th = a * h
         if a > 0.0:
             s1 = math.sin(th) / a
             s2 = (1.0 - math.cos(th)) / (a * a)
         else:
-            s1 = dt
-            s2 = 0.5 * dt * dt
+            s1 = h
+            s2 = 0.5 * h * h
         mul3(Om, Om, T)
         for r in range(3):
             for c in range(3):

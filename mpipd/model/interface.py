@@ -126,9 +126,10 @@ class InterfaceCorrection:
         for name in ("q", "active", "fc"):
             state.add(f"interface_{name}", own, getattr(self, name), rows=self.idx)
 
-    def apply(self, fd, F, f):
-        """f_i -= P_i g_i at the active corrected points."""
-        kern.subtract_ghost_force(fd, F, self.idx, self.q, self.active, f, self.fc)
+    def apply(self, fd, F, f, klass, level):
+        """f_i -= P_i g_i at the active corrected points whose step class acts at
+        ``level`` (with its weight, kernels.classes)."""
+        kern.subtract_ghost_force(fd, F, self.idx, self.q, self.active, f, self.fc, klass, level)
 
     def retire(self, mode) -> int:
         """Switch off the correction where bonds broke or a family member failed."""

@@ -28,6 +28,14 @@ Terms (J, global sums over the owned points of every rank)::
                 gas_damping  removed by the gas damping (§2.6)
                 interface    minus the work of the ghost-force correction (trapezoid;
                              not a potential force, so of either sign)
+                multirate    the jump of the integrator term where the step classes
+                             changed at a coarse boundary (mpipd.model.multirate): the
+                             forces are gathered again with the new weights, and
+                             velocity Verlet with a changed step is not
+                             energy-conserving across the change; of either sign
+                             (it includes, on such a boundary, the jump of the
+                             refresh after breakage, which is booked in
+                             ``removed`` elsewhere); 0 in a single-rate run
     in          initial      held at step 0
                 external     work of the loads (trapezoid)
     balance     (initial + external - held - dissipated) / scale,
@@ -58,7 +66,7 @@ from ..state import AUX, LAST
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
-              "interface")
+              "interface", "multirate")
 #: the datasets of /energy in a run file, in this order
 TERMS = ("t",) + HELD + DISSIPATED + ("external", "initial", "balance")
 #: terms that cannot be negative (beyond round-off and O(dt^2) noise)
@@ -85,6 +93,7 @@ class Energies:
     damping: float = 0.0
     gas_damping: float = 0.0
     interface: float = 0.0
+    multirate: float = 0.0
     external: float = 0.0
     initial: float = 0.0
 
@@ -114,8 +123,10 @@ class Energies:
 
     @classmethod
     def from_record(cls, group, frame: int = -1) -> "Energies":
-        """The reading of one frame of a run file's ``/energy`` group (h5py)."""
-        return cls(**{f.name: float(group[f.name][frame]) for f in fields(cls)})
+        """The reading of one frame of a run file's ``/energy`` group (h5py); a term
+        the file predates (``multirate``) reads 0."""
+        return cls(**{f.name: float(group[f.name][frame]) if f.name in group else 0.0
+                      for f in fields(cls)})
 
     def as_dict(self) -> dict:
         d = {f.name: getattr(self, f.name) for f in fields(self)}
@@ -147,6 +158,7 @@ class Ledger:
         self.interface_work = 0.0
         self.jumps = 0.0                 # hourglass + spring energy removed by discontinuities
         self.contact_jumps = 0.0         # contact energy removed (< 0: added) by them
+        self.reclass = 0.0               # integrator jumps where the step classes changed
         self.initial = None              # global, set once at step 0
 
     def register(self, state, interface):
@@ -163,7 +175,7 @@ class Ledger:
                       restore=LAST)
         else:
             state.add("ledger_fc_old", own, self.fc_old, rows=AUX)     # empty
-        for name in ("viscous_work", "interface_work", "jumps", "contact_jumps"):
+        for name in ("viscous_work", "interface_work", "jumps", "contact_jumps", "reclass"):
             state.scalar(f"ledger_{name}", own, (lambda k=name: getattr(self, k)),
                          (lambda v, k=name: setattr(self, k, float(v))))
         state.scalar("ledger_initial", own, lambda: self.initial,
@@ -221,7 +233,7 @@ class Ledger:
             damping = float(ed.sum()) - gas_damping
         return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, plastic, removed,
                          self.contact_jumps, -self.viscous_work, damping, gas_damping, -self.interface_work,
-                         sim.external_work])
+                         self.reclass, sim.external_work])
 
     def read(self, sim) -> Energies:
         tot = sim.team.sum(self.local(sim))

@@ -1,0 +1,30 @@
+"""Step classes of multi-rate integration (mpipd.model.multirate), kernel side.
+
+A point of class k takes steps dt_k = 2^k dt; at fine step s of a coarse
+interval its state (stress, force state) is evaluated iff 2^k divides s, i.e.
+iff k <= level(s) = min(v_2(s), K) with v_2 the 2-adic valuation and K the
+coarsest class.  Its force state then gives the impulse dt_k f_k: in the fine
+velocity-Verlet step it enters the force with the weight 2^k (Lew et al. 2003,
+asynchronous variational integrators: each state's impulse at its own times).
+Single-rate integration is level 0 with every class 0: every weight is 1.0,
+and x * 1.0 == x, so the kernels give the single-rate numbers bit for bit.
+"""
+import numba
+
+
+@numba.njit(cache=True, inline="always")
+def weight(k, level):
+    """2^k if a class-k state acts at a force evaluation of ``level``, else 0.0."""
+    return float(1 << k) if k <= level else 0.0
+
+
+@numba.njit(cache=True)
+def family_min(offsets, nbr, a, out):
+    """out[i] = min(a[i], min over i's family of a[j]) for the owned points (every
+    bond, broken or not: a broken pair can still touch through contact)."""
+    for i in range(offsets.shape[0] - 1):
+        m = a[i]
+        for b in range(offsets[i], offsets[i + 1]):
+            if a[nbr[b]] < m:
+                m = a[nbr[b]]
+        out[i] = m

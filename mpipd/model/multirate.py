@@ -1,0 +1,198 @@
+"""Multi-rate (subcycled) explicit integration: every point's step class.
+
+Scheme: an asynchronous variational integrator (Lew, Marsden, Ortiz & West
+2003, ARMA 167; 2004, IJNME 60) on power-of-two step classes, the
+peridynamic form of LS-DYNA's element subcycling.  Each point's force state
+(its stress through Eq. 2, its hourglass penalty, its viscosity, its side of a
+bond spring, the ghost-force correction at it) is one "element": it acts on
+the point and on its family.  An element of class k is evaluated every
+dt_k = 2^k dt at the current positions and gives every point of its star the
+impulse dt_k f_k; between impulses every point drifts at constant velocity,
+so every position is known exactly at every fine step and nothing is
+interpolated.  Written as velocity Verlet with the fine dt, that is the
+ordinary step with the force
+
+    f_i^s = sum over the elements e acting at fine step s of 2^k_e f_e,i
+
+(kernels.classes.weight), so the solver's loop, its kicks and the energy
+ledger's identities are unchanged.  Properties (the sources above; Fong,
+Darve & Lew 2008, JCP 227, for the stability analysis):
+
+* linear momentum is conserved exactly: every bond's two impulses have the
+  same weight (a force state's impulses sum to zero; a broken pair's contact
+  takes the pair's finer class), so each impulse exchange sums to zero;
+  angular momentum as in the single-rate model;
+* each element is stable under its own Courant limit, dt_k below the critical
+  step of its material at its current state; AVIs have resonances when a
+  coarse step is a multiple of a fine half-period, dense but very weak in solids;
+* classes are synchronised every ``max_ratio`` fine steps (the coarse step):
+  there all states are current, and failure, breakage, the tension check,
+  frames, checkpoints and progress lines happen only there.
+
+Class rule (at every coarse boundary, identical on any number of ranks: a
+function of each point's own state, then of its family by halo exchange):
+
+    r_i  = safety * dt_c,i * c_p,i / c_i(state) / dt     (dt_c,i: mpipd.check.stable_dt
+                                                          of the point's part; c_p,i its
+                                                          reference P-wave speed)
+    base = floor(log2 r_i), clipped to 0..log2(max_ratio), 0 for the gas
+    k_i  = min over i's family (bonds broken or not) of base_j    (the buffer)
+
+c_i(state) is the material's P-wave speed at the larger of its compression now
+and the compression extrapolated over two coarse steps at its current rate
+(``Material.p_wave_speed_at``: JH2's EOS stiffens steeply, a crushed-zone point
+must take the fine class before it gets there).  Coarsening needs
+``HYSTERESIS`` x the margin (no class flicker at a threshold); refining is
+immediate.  The buffer makes every element's class no coarser than any point
+it pushes.  When a class changes, the forces at the boundary are gathered
+again with the new weights (the second half kick of velocity Verlet with a
+changed step), and the jump of the integrator term this makes is booked in
+the ledger's ``multirate`` entry.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kernels.classes import family_min
+from ..state import LOCAL
+
+#: coarsening needs the class's margin times this (refinement: 1)
+HYSTERESIS = 1.25
+
+
+def level_at(step: int, ratio: int) -> int:
+    """The level of the force evaluation at the end of step ``step`` (the states of
+    classes k <= level act there): the 2-adic valuation of the step within the
+    coarse interval, log2(ratio) at a coarse boundary."""
+    top = ratio.bit_length() - 1
+    s = step % ratio
+    if s == 0:
+        return top
+    return (s & -s).bit_length() - 1
+
+
+class StepClasses:
+    """Step class of every local point (owned first, ghosts after), the coarse-step
+    bookkeeping and the rows each level updates.  Single-rate scenes hold all
+    classes at 0 and every level at 0 (the kernels then give the single-rate numbers)."""
+
+    name = "multirate"
+
+    def __init__(self, scene, points, families, tl):
+        mr = scene.time.multirate
+        self.ratio = mr.max_ratio if mr is not None else 1
+        self.safety = mr.safety if mr is not None else 1.0
+        self.top = self.ratio.bit_length() - 1
+        self.dt = scene.time.dt
+        n, nl = points.n_owned, points.n_local
+        self.n_owned = n
+        self.families = families
+        self.tl = tl[:n]
+        self.klass = np.zeros(nl, np.uint8)             # k of owned + ghosts
+        self.kbase = np.full(nl, self.top, np.uint8)    # before the buffer
+        self.kmin = np.zeros(n, np.uint8)               # min k over the closed family
+        self.level = self.top
+        self._rows = {}
+        if self.enabled:
+            from ..check import stable_dt
+            dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
+            cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
+            self.dtc = dtc[points.part[:n]]
+            self.cp0 = cp[points.part[:n]]
+
+    @property
+    def enabled(self) -> bool:
+        return self.ratio > 1
+
+    def register(self, state):
+        """The classes (checkpointed: the hysteresis needs the last base class, and a
+        restart must go on with the classes it stopped with)."""
+        state.add("step_class", self.name, self.klass, rows=LOCAL, exchanged=True,
+                  checkpoint=True)
+        state.add("step_class_base", self.name, self.kbase, rows=LOCAL, exchanged=True,
+                  checkpoint=True)
+        state.add("step_class_min", self.name, self.kmin)
+
+    # ---------------------------------------------------------------- the schedule
+    def boundary(self, step: int) -> bool:
+        """Is the end of step ``step`` a coarse-step boundary (all classes current)?"""
+        return step % self.ratio == 0
+
+    def set_level(self, step: int):
+        """The level of the force evaluation at the end of step ``step``."""
+        self.level = level_at(step, self.ratio)
+
+    def rows(self, level: int) -> np.ndarray | None:
+        """Owned rows whose class acts at ``level``; None for all of them."""
+        if level >= self.top:
+            return None
+        r = self._rows.get(level)
+        if r is None:
+            r = self._rows[level] = np.flatnonzero(self.klass[:self.n_owned] <= level)
+        return r
+
+    # ---------------------------------------------------------------- the classes
+    def base_classes(self, corr) -> np.ndarray:
+        """Each owned point's class from its own material and state (module docstring)."""
+        n = self.n_owned
+        r = np.zeros(n)                                 # the gas, and any point in no group: 0
+        horizon = 2.0 * self.ratio * self.dt
+        for g in corr.groups:
+            idx = g.idx
+            mu = 1.0 / corr.J_end[idx] - 1.0
+            d = corr.d[idx]
+            rate = -(d[:, 0] + d[:, 1] + d[:, 2]) * (1.0 + mu)
+            mu_ahead = mu + np.maximum(rate, 0.0) * horizon
+            c = np.maximum(g.material.p_wave_speed_at(mu), g.material.p_wave_speed_at(mu_ahead))
+            r[idx] = self.safety * self.dtc[idx] * self.cp0[idx] / c / self.dt
+        with np.errstate(divide="ignore"):
+            down = np.floor(np.log2(np.maximum(r, 1e-300)))
+            up = np.floor(np.log2(np.maximum(r / HYSTERESIS, 1e-300)))
+        down = np.clip(down, 0, self.top).astype(np.uint8)
+        up = np.clip(up, 0, self.top).astype(np.uint8)
+        return np.minimum(down, np.maximum(self.kbase[:n], up))
+
+    def classify(self, corr, halo) -> bool:
+        """New classes from the current state (at a coarse boundary); True if any
+        owned point's class changed (reduce over ranks)."""
+        if not self.enabled:
+            return False
+        n = self.n_owned
+        old = self.klass[:n].copy()
+        self.kbase[:n] = self.base_classes(corr)
+        self._spread(halo)
+        return bool(np.any(self.klass[:n] != old))
+
+    def _spread(self, halo):
+        """The buffer and the receivers' levels, from the owned base classes."""
+        n, fam = self.n_owned, self.families
+        halo.exchange(self.kbase)
+        family_min(fam.offsets, fam.nbr, self.kbase, self.klass[:n])
+        halo.exchange(self.klass)
+        family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
+        self._rows = {}
+
+    def after_restore(self, halo):
+        """Ghost classes and receivers from the restored owned classes."""
+        if self.enabled:
+            n, fam = self.n_owned, self.families
+            halo.exchange(self.klass, self.kbase)
+            family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
+            self._rows = {}
+
+    # ---------------------------------------------------------------- figures
+    def counts(self, n_bonds_of: np.ndarray) -> np.ndarray:
+        """(points, bonds) of this rank's owned points per class, shape (top+1, 2)."""
+        k = self.klass[:self.n_owned]
+        out = np.zeros((self.top + 1, 2), np.int64)
+        for c in range(self.top + 1):
+            sel = k == c
+            out[c] = (int(sel.sum()), int(n_bonds_of[sel].sum()))
+        return out
+
+
+def projected_cost(bonds_per_class) -> float:
+    """Bond evaluations per fine step relative to single-rate: sum_k B_k / 2^k / sum B."""
+    b = np.asarray(bonds_per_class, float)
+    tot = b.sum()
+    return float(sum(b[k] / 2 ** k for k in range(len(b))) / tot) if tot else 1.0
