@@ -106,6 +106,21 @@ def blast_paper_slice(n: int, steps: int) -> dict:
     return d
 
 
+def multirate_pair(case, ratio=4, safety=0.5):
+    """``case`` twice, single-rate and with multi-rate classes (mpipd.model.multirate):
+    run by :func:`main` back to back in one process, reported as wall time per
+    simulated microsecond and their ratio."""
+    def make(n: int, steps: int, multirate: bool = False) -> dict:
+        d = case(n, steps)
+        if multirate:
+            d["time"]["multirate"] = {"max_ratio": ratio, "safety": safety}
+        return d
+    make.__doc__ = (f"{case.__name__}, single-rate and multi-rate (max_ratio {ratio}, "
+                    f"safety {safety})")
+    make.pair = ratio
+    return make
+
+
 def refreshed(case):
     """The case with solver.refresh_after_break on (a second force evaluation on
     steps where bonds broke): its price beside the plain case."""
@@ -120,7 +135,8 @@ def refreshed(case):
 
 CASES = {"elastic": elastic_block, "jh2": jh2_block, "blast": blast_slice,
          "blast_mr": blast_paper_slice, "jh2_refresh": refreshed(jh2_block),
-         "blast_refresh": refreshed(blast_slice)}
+         "blast_refresh": refreshed(blast_slice),
+         "blast_paper_slice": multirate_pair(blast_paper_slice)}
 
 
 def main():
@@ -131,6 +147,8 @@ def main():
     ap.add_argument("--warmup", type=int, default=2)
     args = ap.parse_args()
     team = Team(MPI.COMM_WORLD)
+    if hasattr(CASES[args.case], "pair"):
+        return pair(args, team)
     scene = build(Scene, CASES[args.case](args.size, args.steps + args.warmup))
     t0 = time.perf_counter()
     sim = Simulation(scene, team)
@@ -179,6 +197,44 @@ def main():
               f"steps={args.steps} wall_s={wall:.3f} bond_steps_per_s_per_core={rate:.4g} "
               f"bytes_per_bond={bpb:.2f} bytes_per_point={bpp:.1f} peak_rss_mib={rss:.0f} "
               f"setup_s={setup:.2f}{extra}", flush=True)
+
+
+def pair(args, team):
+    """Single-rate, then multi-rate, of one case in one process (the same JIT cache
+    and machine state): wall time of the time loop per simulated microsecond, the
+    ratio, and the multi-rate run's classes.  Steps and warm-up are rounded up to
+    whole coarse steps."""
+    make = CASES[args.case]
+    r = make.pair
+    steps = -(-args.steps // r) * r
+    warm = -(-max(args.warmup, 1) // r) * r
+    out = {}
+    for mr in (False, True):
+        scene = build(Scene, make(args.size, steps + warm, multirate=mr))
+        sim = Simulation(scene, team)
+        for _ in range(warm):
+            sim.step()
+        team.barrier()
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            sim.step()
+        wall = team.max(time.perf_counter() - t0)
+        out[mr] = wall / (steps * scene.time.dt * 1e6)
+        if mr:
+            cl = sim.classes
+            n = sim.points.n_owned
+            fam = sim.families
+            per = team.sum(cl.counts(fam.offsets[1:n + 1] - fam.offsets[:n]))
+            classes = " ".join(f"class{k}_points={per[k, 0]} class{k}_bonds={per[k, 1]}"
+                               for k in range(len(per)))
+            from mpipd.model.multirate import projected_cost
+            cost = projected_cost(per[:, 1])
+    if team.root:
+        print(f"bench {args.case} ranks={team.size} points={sim.n_global} "
+              f"bonds={sim.n_bonds_global} steps={steps} dt={scene.time.dt:.3g} "
+              f"single_rate_wall_s_per_us={out[False]:.3f} "
+              f"multirate_wall_s_per_us={out[True]:.3f} speedup={out[False] / out[True]:.3f} "
+              f"max_ratio={r} projected_speedup={1 / cost:.3f} {classes}", flush=True)
 
 
 if __name__ == "__main__":

@@ -41,11 +41,13 @@ from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
-BYTES_PER_LOCAL_POINT = 210     # x, gid, part, material, volume, horizon, dx, influence, u, v,
-#                                 fd, cbb, mode
-BYTES_PER_OWNED_POINT = 666     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
+BYTES_PER_LOCAL_POINT = 212     # x, gid, part, material, volume, horizon, dx, influence, u, v,
+#                                 fd, cbb, mode, step class and base class
+BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
-#                                 index, volume factor, fallback toggles, ledger row index
+#                                 index, volume factor, fallback toggles, ledger row index,
+#                                 the family's finest step class
+MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
 BYTES_PER_BOND = 21             # nbr (int32) + broken (uint8) + omega_i, omega_j (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
@@ -83,6 +85,9 @@ def memory_model(scene) -> tuple[int, int]:
         owned += JH2_OWNED            # an upper bound when only some parts are JH2
     if any(f.startswith("peak_") for f in scene.output.fields):
         owned += PEAKS_OWNED
+    mr = scene.time.multirate
+    if mr is not None:
+        local += MULTIRATE_LOCAL_PER_CLASS * (mr.max_ratio.bit_length() - 1)
     return local, owned
 
 
@@ -242,6 +247,8 @@ def check_report(scene, ranks: int) -> str:
     out.append(f"  total: {table.n_points} points, {int(bonds.sum())} bonds "
                f"(counted from the cross-sections)")
     dt_max = critical_dt(scene)
+    if scene.time.multirate is not None and scene.time.multirate.max_ratio > 1:
+        out.extend(class_report(scene, table, bonds, part_dt))
     verdict = ("OK" if dt <= dt_max else
                "TOO LARGE - the run will be unstable; `mpipd run` refuses it without --force")
     out.append(f"  time step: dt = {dt:.4e} s vs stable {dt_max:.4e} s "
@@ -289,6 +296,45 @@ def check_report(scene, ranks: int) -> str:
                    "come from ranks beyond the neighbours (handled by the multi-hop halo, "
                    "at the cost of more messages); fewer ranks avoid it")
     return "\n".join(out)
+
+
+def part_classes(scene, part_dt) -> list[int]:
+    """Each part's step class at rest (mpipd.model.multirate's rule without the
+    buffer and the state): floor(log2(safety dt_c / dt)) in 0..log2(max_ratio),
+    0 for the gas."""
+    mr = scene.time.multirate
+    top = mr.max_ratio.bit_length() - 1
+    out = []
+    for k, q in enumerate(scene.parts):
+        if is_gas_part(scene, q):
+            out.append(0)
+            continue
+        r = mr.safety * min(part_dt[k]) / scene.time.dt
+        out.append(int(min(max(math.floor(math.log2(r)), 0), top)) if r > 0 else 0)
+    return out
+
+
+def class_report(scene, table, bonds, part_dt) -> list[str]:
+    """The multi-rate classes at rest: points and bonds per class and the projected
+    cost per fine step against single-rate (bond evaluations, sum_k B_k / 2^k / B)."""
+    from .model.multirate import projected_cost
+    mr = scene.time.multirate
+    top = mr.max_ratio.bit_length() - 1
+    ks = part_classes(scene, part_dt)
+    of_layer = np.array(ks)[table.part]
+    pts = [int(table.count[of_layer == k].sum()) for k in range(top + 1)]
+    bnd = [int(bonds[of_layer == k].sum()) for k in range(top + 1)]
+    cost = projected_cost(bnd)
+    lines = [f"  multi-rate: max_ratio {mr.max_ratio}, safety {mr.safety:g}; classes at rest "
+             "(before the one-family buffer next to a finer class and the state's refinement, "
+             "which the run applies):"]
+    for k in range(top + 1):
+        names = [q.name for q, c in zip(scene.parts, ks) if c == k]
+        lines.append(f"    class {k} (dt x {2 ** k}): {pts[k]} points, {bnd[k]} bonds"
+                     + (f" - parts {', '.join(names)}" if names else ""))
+    lines.append(f"    projected cost per fine step: {cost:.3f} of single-rate "
+                 f"(at most {1 / cost:.2f}x faster; bond work only)")
+    return lines
 
 
 #: the "far beyond the negative-dp/dmu range" compression the report quotes (K3 mu^3 dominates)

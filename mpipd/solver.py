@@ -170,6 +170,8 @@ class Simulation:
             self.gas.y = None                   # positions come from u, not a past update
         self.classes.level = self.classes.top   # a coarse boundary: every state is current
         self.halo.exchange(self.u, self.v)
+        if self.classes.enabled:
+            self.classes.snapshot(self.u)
         self.corr.deform(self.u, self.v)
         if self.step_count == 0:
             self.corr.initial_volume()
@@ -238,6 +240,8 @@ class Simulation:
     def update(self, dt: float):
         """Everything between the two half kicks: kinematics, stress, forces."""
         self.halo.exchange(self.u, self.v)
+        if self.classes.enabled:
+            self.classes.snapshot(self.u)
         for m in self.models:                       # stress; the gas: Eqs. 45–48, detonation
             m.update(self.u, self.v, dt, self.t + dt)
         self.compute_forces()
@@ -248,8 +252,9 @@ class Simulation:
 
     def step(self):
         """One fine step.  With step classes (mpipd.model.multirate) only the states
-        whose class acts at this step's level are updated and gathered; failure,
-        breakage and the new classes wait for the coarse boundary."""
+        whose class acts at this step's level are updated and gathered; failure
+        and breakage act every step (a coarse point's tension check sees its last
+        state again, which it passed then), new classes at coarse boundaries."""
         dt = self.dt
         cl = self.classes
         cl.set_level(self.step_count + 1)
@@ -259,18 +264,16 @@ class Simulation:
         self.ledger.book_work(self.v, self.points.volume, dt, self.interface)
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
         self.peaks.sample(self)
-        if cl.boundary(self.step_count + 1):
-            refresh = False
-            if self.failure is not None:            # paper §2.7 steps 11–12
-                self.corr.check_tension(self.mode)
-                new = self.failure.update(self.u)
-                if new and self.interface is not None:
-                    self.interface.retire(self.mode)
-                refresh = bool(self.scene.solver.refresh_after_break
-                               and self.team.max(int(new > 0)))
-            changed = self.classify()
-            if refresh or changed:
-                self._refresh_forces(dt, reclassified=changed)
+        refresh = False
+        if self.failure is not None:                # paper §2.7 steps 11–12, every step
+            self.corr.check_tension(self.mode)
+            new = self.failure.update(self.u)
+            if new and self.interface is not None:
+                self.interface.retire(self.mode)
+            refresh = bool(self.scene.solver.refresh_after_break and self.team.max(int(new > 0)))
+        changed = cl.boundary(self.step_count + 1) and self.classify()
+        if refresh or changed:
+            self._refresh_forces(dt, reclassified=changed)
         self.step_count += 1
         self.t = self.step_count * dt
 

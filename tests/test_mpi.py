@@ -121,3 +121,29 @@ def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
             assert np.array_equal(f.attrs["failed_points_by_mode"], modes)
             for k, a in ref.items():
                 assert np.array_equal(f[k][...], a), f"{k} differs between 1 and {n} ranks"
+
+
+@pytest.fixture(scope="module")
+def multirate_runs(tmp_path_factory):
+    """granite_ring with multi-rate classes (rock class 2, the crushed zone finer)."""
+    return run_on_1_2_3(tmp_path_factory.mktemp("mr"), "granite_ring",
+                        FRACTURE + ["--set", "time.multirate={max_ratio=4, safety=1.0}"])
+
+
+def test_multirate_identical_on_1_2_3_ranks(multirate_runs, fracture_runs):
+    keys = ("fields/u", "fields/v", "fields/damage", "fields/failure_mode", "fields/pressure",
+            "energy/multirate", "probes/near/sigma_rr", "probes/far/v_r")
+    with h5py.File(multirate_runs[1], "r") as f1:
+        ref = {k: f1[k][...] for k in keys}
+        broken = f1.attrs["bonds_broken"]
+    with h5py.File(fracture_runs[1], "r") as f:          # multi-rate is not single-rate
+        assert not np.array_equal(f["fields/u"][...], ref["fields/u"])
+    assert broken > 1000 and ref["energy/multirate"][-1] != 0.0
+    for n in (2, 3):
+        with h5py.File(multirate_runs[n], "r") as f:
+            assert f.attrs["bonds_broken"] == broken
+            for k in keys:
+                if k.startswith("energy/"):     # global sums: reduction order (1e-12 J)
+                    np.testing.assert_allclose(f[k][...], ref[k], rtol=0, atol=1e-12)
+                else:
+                    assert np.array_equal(f[k][...], ref[k]), f"{k} differs between 1 and {n} ranks"

@@ -61,6 +61,28 @@ def test_restart_same_and_different_rank_count(tmp_path, reference):
                 assert np.array_equal(f[k][...], reference[k]), f"{k} differs after restart on {n}"
 
 
+MR = ["--set", "time.multirate={max_ratio=4, safety=1.0}"]
+
+
+def test_multirate_restart_on_another_rank_count(tmp_path):
+    """Multi-rate: stopped at a coarse boundary on 2 ranks, continued on 3, the same
+    fields as the uninterrupted run on 1 rank (the classes are checkpointed)."""
+    ref = tmp_path / "ref"
+    res = run_cli(["run", "granite_ring", "--out", str(ref), *ARGS, *MR], ranks=1)
+    assert res.returncode == 0, res.stderr
+    a = tmp_path / "a"
+    res = run_cli(["run", "granite_ring", "--out", str(a), "--stop-after", "232", *ARGS, *MR],
+                  ranks=2)
+    assert res.returncode == 0, res.stderr
+    assert "stopped at step 232" in res.stdout
+    res = run_cli(["run", "--restart", str(a / "checkpoint.h5"), "--quiet"], ranks=3)
+    assert res.returncode == 0, res.stdout + res.stderr
+    with h5py.File(ref / "run.h5", "r") as f0, h5py.File(a / "run.h5", "r") as f1:
+        assert f1.attrs["bonds_broken"] == f0.attrs["bonds_broken"]
+        for k in KEYS:
+            assert np.array_equal(f1[k][...], f0[k][...]), f"{k} differs after restart"
+
+
 def test_bad_checkpoint_is_a_clear_error(tmp_path):
     bad = tmp_path / "checkpoint.h5"
     bad.write_bytes(b"not hdf5")

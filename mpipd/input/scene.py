@@ -81,11 +81,11 @@ class Multirate:
 
     def check(self, path):
         if self.max_ratio not in MAX_RATIOS:
-            fail(join(path, "max_ratio"), "must be one of "
+            fail(join(path, "max_ratio"), "max_ratio must be one of "
                  + ", ".join(map(str, MAX_RATIOS)) + f" (a power of two up to {MAX_RATIOS[-1]}, "
                  f"the ratios the verification covers); got {self.max_ratio}")
         if not 0.0 < self.safety <= 1.0:
-            fail(join(path, "safety"), f"must be in (0, 1] (got {self.safety})")
+            fail(join(path, "safety"), f"safety must be in (0, 1] (got {self.safety})")
 
 
 #: the coarse/fine step ratios multi-rate integration accepts (verified in make verify)

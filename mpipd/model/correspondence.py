@@ -204,7 +204,10 @@ class Correspondence(Model):
             c <- c det F / det F'      (so c' det F' = c det F),
 
         F and F_old become F' (the next rotation increment then compares F's
-        of one family).  Without it J = det F jumps when a family turns
+        of one family).  A point of a coarse class between its updates
+        (multi-rate) is rebuilt at the positions of its last update, where its F
+        and F_old are (mpipd.model.multirate.StepClasses.u_at_update), so that its
+        next update's increment is taken over one family.  Without it J = det F jumps when a family turns
         one-sided (a JH2 point went 133 MPa -> 18 GPa through K3 mu^3 with no
         work done) and the pressure then does work that nothing put in.
         """
@@ -217,8 +220,17 @@ class Correspondence(Model):
         self.spring[self.not_tl] = NOT_TL
         if u is not None and len(which):
             Fn = np.empty((len(which), 3, 3))
-            nosb.gradients_of(which, p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
-                              fam.nbr, fam.broken, self.Kinv, self.spring, Fn)
+            cl = self.classes
+            kw = cl.klass[which]
+            for k in np.unique(kw):
+                # a point between its updates (coarse class, multi-rate): F' at the
+                # positions of its last update, where its F and F_old are
+                sel = np.flatnonzero(kw == k) if len(np.unique(kw)) > 1 else slice(None)
+                Fk = np.empty((len(which[sel]), 3, 3))
+                nosb.gradients_of(which[sel], p.x, cl.u_at_update(int(k) if k > cl.level else 0, u),
+                                  p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                                  fam.broken, self.Kinv, self.spring, Fk)
+                Fn[sel] = Fk
             j_old = np.linalg.det(self.F[which])
             j_new = np.linalg.det(Fn)
             ok = before & (self.spring[which] == CORRESPONDENCE) & (j_old > 0) & (j_new > 0)

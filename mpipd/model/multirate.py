@@ -54,7 +54,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.classes import family_min
-from ..state import LOCAL
+from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
 HYSTERESIS = 1.25
@@ -93,6 +93,9 @@ class StepClasses:
         self.kmin = np.zeros(n, np.uint8)               # min k over the closed family
         self.level = self.top
         self._rows = {}
+        #: u (owned + ghosts) at the last update of each coarse class 1..top: a point
+        #: whose family changes between its updates rebuilds F at those positions
+        self.u_then = np.zeros((self.top, nl, 3))
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -112,6 +115,7 @@ class StepClasses:
         state.add("step_class_base", self.name, self.kbase, rows=LOCAL, exchanged=True,
                   checkpoint=True)
         state.add("step_class_min", self.name, self.kmin)
+        state.add("step_class_u", self.name, self.u_then.reshape(-1, 3), rows=AUX)
 
     # ---------------------------------------------------------------- the schedule
     def boundary(self, step: int) -> bool:
@@ -121,6 +125,16 @@ class StepClasses:
     def set_level(self, step: int):
         """The level of the force evaluation at the end of step ``step``."""
         self.level = level_at(step, self.ratio)
+
+    def snapshot(self, u):
+        """Keep u as the positions of the classes updated at this level (after the
+        halo exchange of u; every class at a coarse boundary)."""
+        for k in range(1, min(self.level, self.top) + 1):
+            self.u_then[k - 1] = u
+
+    def u_at_update(self, k: int, u):
+        """u at the last update of class k (the current u for class 0)."""
+        return u if k == 0 else self.u_then[k - 1]
 
     def rows(self, level: int) -> np.ndarray | None:
         """Owned rows whose class acts at ``level``; None for all of them."""
@@ -175,7 +189,7 @@ class StepClasses:
     def after_restore(self, halo):
         """Ghost classes and receivers from the restored owned classes."""
         if self.enabled:
-            n, fam = self.n_owned, self.families
+            fam = self.families
             halo.exchange(self.klass, self.kbase)
             family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
             self._rows = {}
