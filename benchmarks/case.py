@@ -222,9 +222,7 @@ def pair(args, team):
         out[mr] = wall / (steps * scene.time.dt * 1e6)
         if mr:
             cl = sim.classes
-            n = sim.points.n_owned
-            fam = sim.families
-            per = team.sum(cl.counts(fam.offsets[1:n + 1] - fam.offsets[:n]))
+            per = team.sum(cl.counts(cl.fam_bonds))
             classes = " ".join(f"class{k}_points={per[k, 0]} class{k}_bonds={per[k, 1]}"
                                for k in range(len(per)))
             from mpipd.model.multirate import projected_cost

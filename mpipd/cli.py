@@ -295,6 +295,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     if sim.failure is not None:
         log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))
             + f"; {broken} bonds broken")
+    if sim.classes.enabled:
+        line = sim.classes.summary(team)
+        log("mpipd: " + line)
     from .model.ledger import impossible
     e = sim.energies()
     log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "

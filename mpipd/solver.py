@@ -214,14 +214,23 @@ class Simulation:
         else:
             self.ledger.jumps += jump
 
+    def hold_classes(self, kbase):
+        """Hold the owned points' step classes at ``kbase`` (StepClasses.hold) and
+        recompute the forces with them (at step 0: a verification device)."""
+        self.classes.hold(kbase, self.halo)
+        self.corr.regroup()
+        self.initialize()
+
     def classify(self) -> bool:
         """New step classes from the current state (a coarse boundary; multi-rate
         only); True, on every rank, if any point's class changed."""
         if not self.classes.enabled:
             return False
-        changed = bool(self.team.max(int(self.classes.classify(self.corr, self.halo))))
+        changed = bool(self.team.max(int(self.classes.classify(self.corr, self.halo,
+                                                                self.step_count + 1))))
         if changed:
             self.corr.regroup()
+            self.classes.changes += 1
         return changed
 
     def apply_loads(self, t: float, dt: float):
@@ -268,6 +277,7 @@ class Simulation:
         if self.failure is not None:                # paper §2.7 steps 11–12, every step
             self.corr.check_tension(self.mode)
             new = self.failure.update(self.u)
+            cl.touch(self.failure.rebuilt, self.step_count + 1)
             if new and self.interface is not None:
                 self.interface.retire(self.mode)
             refresh = bool(self.scene.solver.refresh_after_break and self.team.max(int(new > 0)))

@@ -10,7 +10,8 @@ from mpipd.solver import Simulation
 @pytest.mark.parametrize("name,over", [
     ("elastic_wave", ["parts.0.dx=0.004"]),
     ("granite_ring", ["parts.0.dx=0.002"]),
-    ("granite_ring", ["parts.0.dx=0.002", "time.multirate={max_ratio=8}", "output.every=40"]),
+    ("granite_ring", ["parts.0.dx=0.002", "time.multirate={max_ratio=8}", "output.every=40",
+                      "time.t_end=1.6e-5"]),
     ("detonation_tube", ["parts.2.shape.radius=0.005"]),
 ])
 def test_memory_model_matches_allocation(team, name, over):

@@ -37,12 +37,7 @@ def bar(dt, t_end, ratio=None, coarse=None, x_split=0.04):
         forced = np.full(n, coarse, np.uint8)
         if x_split is not None:
             forced[x < x_split] = 0
-        cl = sim.classes
-        cl.base_classes = lambda corr: forced
-        cl.kbase[:n] = forced
-        cl._spread(sim.halo)
-        sim.corr.regroup()
-        sim.initialize()
+        sim.hold_classes(forced)
     return scene, sim
 
 

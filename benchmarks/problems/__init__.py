@@ -15,6 +15,7 @@ key             module                problem
 ``jh2_point``   :mod:`.jh2_point`     one JH2 point on a uniaxial-strain path
 ``detonation``  :mod:`.detonation`    explosive column in a copper tube
 ``isentrope_dt`` :mod:`.detonation`   the same at one dx with dt refined alone
+``wave_multirate`` :mod:`.wave_multirate` the plane wave across a multi-rate class boundary
 ==============  ====================  ==============================================
 
 :mod:`.common` holds what they share (the paper's granite, scene building, the
@@ -29,6 +30,8 @@ from .energy import Energy
 from .jh2_point import JH2Point
 from .lame import Lame
 from .wave import Wave
+from .wave_multirate import WaveMultirate
 
 PROBLEMS = {"wave": Wave, "lame": Lame, "energy": Energy, "jh2_point": JH2Point,
-            "detonation": Detonation, "isentrope_dt": IsentropeDt}
+            "detonation": Detonation, "isentrope_dt": IsentropeDt,
+            "wave_multirate": WaveMultirate}

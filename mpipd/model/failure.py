@@ -84,6 +84,7 @@ class Failure:
         t1 = time.perf_counter()
         self.exchange_seconds += t1 - t0
         new = np.flatnonzero((self.mode != 0) & (self.done == 0))
+        self.rebuilt = new[:0]                  # owned points whose family changed now
         if len(new):
             self.done[new] = 1
             p, fam = self.points, self.families
@@ -95,6 +96,7 @@ class Failure:
             self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx, p.material,
                                              fam.offsets, fam.nbr, fam.broken, self.touched)
             changed = np.flatnonzero(self.touched)
+            self.rebuilt = changed
             if len(changed):
                 self.touched[changed] = 0
                 self.corr.rebuild_shape(changed, u)

@@ -58,6 +58,8 @@ from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
 HYSTERESIS = 1.25
+#: a point whose family changed (bonds broke) within this many coarse steps is fine
+RECENT = 2
 
 
 def level_at(step: int, ratio: int) -> int:
@@ -91,8 +93,17 @@ class StepClasses:
         self.klass = np.zeros(nl, np.uint8)             # k of owned + ghosts
         self.kbase = np.full(nl, self.top, np.uint8)    # before the buffer
         self.kmin = np.zeros(n, np.uint8)               # min k over the closed family
+        #: the step at which each owned point's family last changed (bonds broke)
+        self.touched = np.full(n if self.ratio > 1 else 0, -(1 << 40), np.int64)
         self.level = self.top
         self._rows = {}
+        self._held = None
+        # this invocation's figures (the run log): bond states evaluated, steps,
+        # coarse boundaries, and those where a class changed (a second force gather)
+        self.fam_bonds = np.diff(families.offsets)
+        self.bonds_by_class = np.zeros(self.top + 1)
+        self.evaluated = 0.0
+        self.steps = self.boundaries = self.changes = 0
         #: u (owned + ghosts) at the last update of each coarse class 1..top: a point
         #: whose family changes between its updates rebuilds F at those positions
         self.u_then = np.zeros((self.top, nl, 3))
@@ -115,6 +126,7 @@ class StepClasses:
         state.add("step_class_base", self.name, self.kbase, rows=LOCAL, exchanged=True,
                   checkpoint=True)
         state.add("step_class_min", self.name, self.kmin)
+        state.add("step_class_touched", self.name, self.touched, checkpoint=self.enabled)
         state.add("step_class_u", self.name, self.u_then.reshape(-1, 3), rows=AUX)
 
     # ---------------------------------------------------------------- the schedule
@@ -125,6 +137,8 @@ class StepClasses:
     def set_level(self, step: int):
         """The level of the force evaluation at the end of step ``step``."""
         self.level = level_at(step, self.ratio)
+        self.evaluated += float(self.bonds_by_class[:self.level + 1].sum())
+        self.steps += 1
 
     def snapshot(self, u):
         """Keep u as the positions of the classes updated at this level (after the
@@ -146,9 +160,26 @@ class StepClasses:
         return r
 
     # ---------------------------------------------------------------- the classes
-    def base_classes(self, corr) -> np.ndarray:
+    def hold(self, kbase, halo):
+        """Hold the owned points' base classes at ``kbase`` from now on instead of
+        taking them from the state: a verification device that puts a class
+        boundary where nothing else changes (tests/test_multirate.py,
+        benchmarks/problems/wave_multirate.py).  The caller regroups the
+        materials and recomputes the forces (Simulation.hold_classes)."""
+        self._held = np.asarray(kbase, np.uint8).copy()
+        self.kbase[:self.n_owned] = self._held
+        self._spread(halo)
+
+    def touch(self, rows, step: int):
+        """The families of the owned ``rows`` changed at ``step`` (bonds broke)."""
+        if self.enabled and len(rows):
+            self.touched[rows] = step
+
+    def base_classes(self, corr, step: int = 0) -> np.ndarray:
         """Each owned point's class from its own material and state (module docstring)."""
         n = self.n_owned
+        if self._held is not None:
+            return self._held
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
         horizon = 2.0 * self.ratio * self.dt
         for g in corr.groups:
@@ -164,17 +195,22 @@ class StepClasses:
             up = np.floor(np.log2(np.maximum(r / HYSTERESIS, 1e-300)))
         down = np.clip(down, 0, self.top).astype(np.uint8)
         up = np.clip(up, 0, self.top).astype(np.uint8)
-        return np.minimum(down, np.maximum(self.kbase[:n], up))
+        k = np.minimum(down, np.maximum(self.kbase[:n], up))
+        # fracturing: a family that changed (bonds broke) within the last RECENT coarse
+        # steps takes the finest class
+        k[step - self.touched <= RECENT * self.ratio] = 0
+        return k
 
-    def classify(self, corr, halo) -> bool:
+    def classify(self, corr, halo, step: int) -> bool:
         """New classes from the current state (at a coarse boundary); True if any
         owned point's class changed (reduce over ranks)."""
         if not self.enabled:
             return False
         n = self.n_owned
         old = self.klass[:n].copy()
-        self.kbase[:n] = self.base_classes(corr)
+        self.kbase[:n] = self.base_classes(corr, step)
         self._spread(halo)
+        self.boundaries += 1
         return bool(np.any(self.klass[:n] != old))
 
     def _spread(self, halo):
@@ -184,7 +220,13 @@ class StepClasses:
         family_min(fam.offsets, fam.nbr, self.kbase, self.klass[:n])
         halo.exchange(self.klass)
         family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
+        self._recount()
+
+    def _recount(self):
         self._rows = {}
+        k = self.klass[:self.n_owned]
+        self.bonds_by_class = np.bincount(k, weights=self.fam_bonds,
+                                          minlength=self.top + 1).astype(float)
 
     def after_restore(self, halo):
         """Ghost classes and receivers from the restored owned classes."""
@@ -192,9 +234,22 @@ class StepClasses:
             fam = self.families
             halo.exchange(self.klass, self.kbase)
             family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
-            self._rows = {}
+            self._recount()
 
     # ---------------------------------------------------------------- figures
+    def summary(self, team) -> str:
+        """One line for the run log: the classes now, the share of the single-rate
+        bond work this invocation evaluated, and how often the classes changed."""
+        per = team.sum(self.counts(self.fam_bonds))
+        ev = team.sum(np.array([self.evaluated, float(self.steps)]))
+        total = float(per[:, 1].sum())
+        share = ev[0] / max(ev[1] / team.size * total, 1.0)
+        cls = ", ".join(f"class {k} (dt x {2 ** k}) {per[k, 0]} points / {per[k, 1]} bonds"
+                        for k in range(self.top + 1))
+        return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}): now {cls}; "
+                f"bond states evaluated {share:.3f} of single-rate's; classes changed at "
+                f"{self.changes} of {self.boundaries} coarse steps (a second force gather each)")
+
     def counts(self, n_bonds_of: np.ndarray) -> np.ndarray:
         """(points, bonds) of this rank's owned points per class, shape (top+1, 2)."""
         k = self.klass[:self.n_owned]
