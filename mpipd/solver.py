@@ -221,6 +221,20 @@ class Simulation:
         self.corr.regroup()
         self.initialize()
 
+    def _reweight(self):
+        """The next half kick's forces with the step classes that just changed: the
+        correspondence forces are gathered again (old and new weights) only where a
+        family holds a changed class, and a follows there.  The jump of the
+        integrator term is the ledger's ``multirate`` entry."""
+        before = self.ledger.integrator(self)
+        rows = self.classes.reweighted_rows()
+        self.corr.reweight(rows, self.u, self.v, self.f, self.ledger.fv, self.classes.previous)
+        a = self.f[rows] * (1.0 / self.rho[rows])[:, None]          # as integrate.kick
+        a[self.fixed[rows].astype(bool)] = 0.0
+        self.a[rows] = a
+        self.ledger.start(self.interface)
+        self.ledger.reclass += before - self.ledger.integrator(self)
+
     def classify(self) -> bool:
         """New step classes from the current state (a coarse boundary; multi-rate
         only); True, on every rank, if any point's class changed."""
@@ -282,8 +296,10 @@ class Simulation:
                 self.interface.retire(self.mode)
             refresh = bool(self.scene.solver.refresh_after_break and self.team.max(int(new > 0)))
         changed = cl.boundary(self.step_count + 1) and self.classify()
-        if refresh or changed:
+        if refresh:
             self._refresh_forces(dt, reclassified=changed)
+        elif changed:
+            self._reweight()
         self.step_count += 1
         self.t = self.step_count * dt
 

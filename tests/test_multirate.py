@@ -153,9 +153,11 @@ def test_too_coarse_a_class_is_detected():
 def test_state_following_classes_and_the_ledger():
     """granite_ring (JH2, tension failure, contact, viscosity, damping) with classes
     from the state: the crushed zone takes the fine class, classes change at
-    boundaries (booked in the ledger's multirate term) and the ledger closes."""
+    boundaries (booked in the ledger's multirate term) and the ledger closes
+    (refresh_after_break on, as in test_ledger's bound for this impact: without
+    it the pre-break force of every breakage is a first-order error of its own)."""
     over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
-            "time.multirate={max_ratio=4, safety=0.9}"]
+            "time.multirate={max_ratio=4, safety=0.9}", "solver.refresh_after_break=true"]
     scene, _ = sc.load("granite_ring", over)
     sim = Simulation(scene, _team())
     n = sim.points.n_owned
@@ -167,6 +169,6 @@ def test_state_following_classes_and_the_ledger():
     k = sim.classes.klass[:n]
     assert e.multirate != 0.0                    # classes changed and the jump was booked
     assert np.all(k[(r < 0.006) & (sim.mode[:n] == 0)] < 2)   # the crushed zone went fine
-    assert bal < 1e-3                            # measured 5.2e-4
+    assert bal < 1e-4                            # measured 3.1e-5 (single-rate: 1.7e-6)
     # the multirate term is needed: without it the ledger would not close to the bound
-    assert abs(e.multirate) / e.scale > 1e-3     # measured 1.2e-3
+    assert abs(e.multirate) / e.scale > 1e-3     # measured 2.2e-3

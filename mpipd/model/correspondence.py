@@ -316,6 +316,31 @@ class Correspondence(Model):
         if self.interface is not None:
             self.interface.apply(self.fd, self.F, f, cl.klass, cl.level)
 
+    def reweight(self, rows, u, v, f, fv, previous):
+        """The forces of the owned ``rows`` after the step classes changed at a coarse
+        boundary (every state current, force data and its ghosts unchanged): f
+        (and fv) += gather(new weights) - gather(old weights) there, so the gas's,
+        the loads' and the other points' forces stay as they are.  The interface
+        correction's force fc is left with the new weights."""
+        p, fam, cl = self.points, self.families, self.classes
+        n = p.n_owned
+        mask = np.full(n, 255, np.uint8)
+        mask[rows] = 0
+        out = []
+        for klass in (previous, cl.klass):
+            g = np.zeros((n, 3))
+            gv = np.zeros_like(fv)
+            nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
+                               fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb,
+                               self.contact, g, gv, klass, mask, cl.top)
+            if self.interface is not None:
+                self.interface.apply(self.fd, self.F, g, klass, cl.top)
+            out.append((g[rows], gv[rows] if len(gv) else gv))
+        (g0, v0), (g1, v1) = out
+        f[rows] += g1 - g0
+        if len(fv):
+            fv[rows] += v1 - v0
+
     def commit(self):
         """F_old <- F of the points updated at this level."""
         rows = self.classes.rows(self.classes.level)

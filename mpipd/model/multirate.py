@@ -98,6 +98,7 @@ class StepClasses:
         self.level = self.top
         self._rows = {}
         self._held = None
+        self.previous = self.klass                     # the classes before the last change
         # this invocation's figures (the run log): bond states evaluated, steps,
         # coarse boundaries, and those where a class changed (a second force gather)
         self.fam_bonds = np.diff(families.offsets)
@@ -207,11 +208,19 @@ class StepClasses:
         if not self.enabled:
             return False
         n = self.n_owned
-        old = self.klass[:n].copy()
+        self.previous = self.klass.copy()
         self.kbase[:n] = self.base_classes(corr, step)
         self._spread(halo)
         self.boundaries += 1
-        return bool(np.any(self.klass[:n] != old))
+        return bool(np.any(self.klass[:n] != self.previous[:n]))
+
+    def reweighted_rows(self) -> np.ndarray:
+        """Owned points whose closed family holds a point whose class just changed
+        (ghosts included): the forces there change with the weights."""
+        same = (self.klass == self.previous).astype(np.uint8)
+        out = np.empty(self.n_owned, np.uint8)
+        family_min(self.families.offsets, self.families.nbr, same, out)
+        return np.flatnonzero(out == 0)
 
     def _spread(self, halo):
         """The buffer and the receivers' levels, from the owned base classes."""
