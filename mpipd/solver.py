@@ -128,6 +128,8 @@ class Simulation:
                                 self.tl, self.mode, self.ledger) if scene.can_fail else None)
         if self.failure is not None:
             self.failure.register(st)
+            if self.classes.enabled:            # multi-rate's breakage clock
+                self.failure.on_rebuild = self.classes.touch
         # the models of the further families the scene's parts use (the explosive gas)
         self.models: list[Model] = [self.corr]
         used = {scene.materials[q.material].family for q in scene.parts}
@@ -291,7 +293,6 @@ class Simulation:
         if self.failure is not None:                # paper §2.7 steps 11–12, every step
             self.corr.check_tension(self.mode)
             new = self.failure.update(self.u)
-            cl.touch(self.failure.rebuilt, self.step_count + 1)
             if new and self.interface is not None:
                 self.interface.retire(self.mode)
             refresh = bool(self.scene.solver.refresh_after_break and self.team.max(int(new > 0)))

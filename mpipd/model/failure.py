@@ -58,6 +58,8 @@ class Failure:
         # first wait after the step's work and absorbs the ranks' imbalance
         self.seconds = 0.0
         self.exchange_seconds = 0.0
+        #: called with the owned points whose family changed (multi-rate's clock)
+        self.on_rebuild = None
         self.refresh_damage()
 
     def register(self, state):
@@ -84,7 +86,6 @@ class Failure:
         t1 = time.perf_counter()
         self.exchange_seconds += t1 - t0
         new = np.flatnonzero((self.mode != 0) & (self.done == 0))
-        self.rebuilt = new[:0]                  # owned points whose family changed now
         if len(new):
             self.done[new] = 1
             p, fam = self.points, self.families
@@ -96,7 +97,8 @@ class Failure:
             self.bonds_broken += break_bonds(new[rows[own]], items[own], p.x, p.gid, p.dx, p.material,
                                              fam.offsets, fam.nbr, fam.broken, self.touched)
             changed = np.flatnonzero(self.touched)
-            self.rebuilt = changed
+            if self.on_rebuild is not None:
+                self.on_rebuild(changed)
             if len(changed):
                 self.touched[changed] = 0
                 self.corr.rebuild_shape(changed, u)

@@ -96,13 +96,13 @@ class StepClasses:
         #: the step at which each owned point's family last changed (bonds broke)
         self.touched = np.full(n if self.ratio > 1 else 0, -(1 << 40), np.int64)
         self.level = self.top
+        self.step = 0
         self._rows = {}
         self._held = None
         self.previous = self.klass                     # the classes before the last change
         # this invocation's figures (the run log): bond states evaluated, steps,
         # coarse boundaries, and those where a class changed (a second force gather)
-        self.fam_bonds = np.diff(families.offsets)
-        self.bonds_by_class = np.zeros(self.top + 1)
+        self.bonds_by_class = [0.0] * (self.top + 1)
         self.evaluated = 0.0
         self.steps = self.boundaries = self.changes = 0
         #: u (owned + ghosts) at the last update of each coarse class 1..top: a point
@@ -116,16 +116,21 @@ class StepClasses:
             self.cp0 = cp[points.part[:n]]
 
     @property
+    def fam_bonds(self) -> np.ndarray:
+        """Bonds of each owned point's family (a temporary)."""
+        return np.diff(self.families.offsets)
+
+    @property
     def enabled(self) -> bool:
         return self.ratio > 1
 
     def register(self, state):
         """The classes (checkpointed: the hysteresis needs the last base class, and a
         restart must go on with the classes it stopped with)."""
-        state.add("step_class", self.name, self.klass, rows=LOCAL, exchanged=True,
+        state.add("step_class", self.name, self.klass, rows=LOCAL, exchanged=self.enabled,
                   checkpoint=True)
-        state.add("step_class_base", self.name, self.kbase, rows=LOCAL, exchanged=True,
-                  checkpoint=True)
+        state.add("step_class_base", self.name, self.kbase, rows=LOCAL,
+                  exchanged=self.enabled, checkpoint=True)
         state.add("step_class_min", self.name, self.kmin)
         state.add("step_class_touched", self.name, self.touched, checkpoint=self.enabled)
         state.add("step_class_u", self.name, self.u_then.reshape(-1, 3), rows=AUX)
@@ -138,7 +143,8 @@ class StepClasses:
     def set_level(self, step: int):
         """The level of the force evaluation at the end of step ``step``."""
         self.level = level_at(step, self.ratio)
-        self.evaluated += float(self.bonds_by_class[:self.level + 1].sum())
+        self.step = step
+        self.evaluated += sum(self.bonds_by_class[:self.level + 1])
         self.steps += 1
 
     def snapshot(self, u):
@@ -171,10 +177,11 @@ class StepClasses:
         self.kbase[:self.n_owned] = self._held
         self._spread(halo)
 
-    def touch(self, rows, step: int):
-        """The families of the owned ``rows`` changed at ``step`` (bonds broke)."""
-        if self.enabled and len(rows):
-            self.touched[rows] = step
+    def touch(self, rows):
+        """The families of the owned ``rows`` changed in the current step (bonds broke;
+        Failure.on_rebuild)."""
+        if len(rows):
+            self.touched[rows] = self.step
 
     def base_classes(self, corr, step: int = 0) -> np.ndarray:
         """Each owned point's class from its own material and state (module docstring)."""
@@ -235,7 +242,7 @@ class StepClasses:
         self._rows = {}
         k = self.klass[:self.n_owned]
         self.bonds_by_class = np.bincount(k, weights=self.fam_bonds,
-                                          minlength=self.top + 1).astype(float)
+                                          minlength=self.top + 1).tolist()
 
     def after_restore(self, halo):
         """Ghost classes and receivers from the restored owned classes."""
