@@ -2,8 +2,9 @@
 
     python benchmarks/multirate_compare.py --out FILE.md LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 
-Each RUN_DIR holds ``run.h5`` and ``report/report.json`` (``python -m postprocess
-report``).  The first run is the reference.  The table gives, for every run:
+Each RUN_DIR holds ``run.h5`` and, for the target rows, ``report/report.json``
+(``python -m postprocess report``; without it the table has the run rows only).
+The first run is the reference.  The table gives, for every run:
 
 * its commit, ranks and loop wall time (run.h5 ``segments``);
 * the failed points by mode and the bonds broken;
@@ -36,8 +37,9 @@ def read(run_dir: Path) -> dict:
                "broken": int(f.attrs["bonds_broken"]),
                "balance": float(f["energy/balance"][-1]),
                "multirate": float(f["energy/multirate"][-1]) if "energy/multirate" in f else 0.0}
-    rep = json.loads((run_dir / "report" / "report.json").read_text())
-    out["targets"] = [(t["label"], t.get("unit", ""), t.get("value")) for t in rep["targets"]]
+    rep = run_dir / "report" / "report.json"
+    out["targets"] = ([(t["label"], t.get("unit", ""), t.get("value"))
+                       for t in json.loads(rep.read_text())["targets"]] if rep.exists() else [])
     return out
 
 
@@ -59,14 +61,14 @@ def table(runs: dict) -> str:
     head = "| quantity | " + " | ".join(labels) + " |\n|---|" + "---|" * len(labels) + "\n"
     rows = []
 
-    def row(name, get):
+    def row(name, get, diff=True):
         vals = [get(runs[k]) for k in labels]
         r0 = vals[0]
         rows.append(f"| {name} | " + " | ".join(
-            fmt(v) + (pct(v, r0) if i else "") for i, v in enumerate(vals)) + " |")
-    row("commit", lambda r: r["commit"])
-    row("ranks", lambda r: r["ranks"])
-    row("dt (s)", lambda r: r["dt"])
+            fmt(v) + (pct(v, r0) if i and diff else "") for i, v in enumerate(vals)) + " |")
+    row("commit", lambda r: r["commit"], False)
+    row("ranks", lambda r: r["ranks"], False)
+    row("dt (s)", lambda r: r["dt"], False)
     row("loop wall time (s)", lambda r: round(r["wall"], 1))
     row("failed: JH2 plastic", lambda r: r["modes"][1])
     row("failed: JH2 tensile", lambda r: r["modes"][2])
@@ -91,8 +93,9 @@ def main(argv=None):
         runs[label] = read(Path(path))
     text = ("Made by `python benchmarks/multirate_compare.py` from the run directories "
             + ", ".join(f"`{item.partition('=')[2]}`" for item in args.runs)
-            + f"; the reference is {list(runs)[0]}.  Values of the report's targets "
-            "(postprocess report); in brackets the difference from the reference.\n\n"
+            + f"; the reference is {list(runs)[0]}.  Run rows from run.h5, then the report's "
+            "targets (postprocess report) where the runs have one; in brackets the "
+            "difference from the reference.\n\n"
             + table(runs))
     Path(args.out).write_text(text)
     sys.stdout.write(text)

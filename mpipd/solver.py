@@ -102,7 +102,7 @@ class Simulation:
 
         sv = scene.solver
         # step classes (multi-rate; all 0 in a single-rate scene)
-        self.classes = StepClasses(scene, p, self.families, self.tl)
+        self.classes = StepClasses(scene, p, self.families)
         self.classes.register(st)
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
                                    self.mode, self.classes, contact=sv.contact,
@@ -301,6 +301,7 @@ class Simulation:
             self._refresh_forces(dt, reclassified=changed)
         elif changed:
             self._reweight()
+        cl.previous = cl.klass                  # the old classes are no longer needed
         self.step_count += 1
         self.t = self.step_count * dt
 

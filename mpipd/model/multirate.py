@@ -80,7 +80,7 @@ class StepClasses:
 
     name = "multirate"
 
-    def __init__(self, scene, points, families, tl):
+    def __init__(self, scene, points, families):
         mr = scene.time.multirate
         self.ratio = mr.max_ratio if mr is not None else 1
         self.safety = mr.safety if mr is not None else 1.0
@@ -89,7 +89,6 @@ class StepClasses:
         n, nl = points.n_owned, points.n_local
         self.n_owned = n
         self.families = families
-        self.tl = tl[:n]
         self.klass = np.zeros(nl, np.uint8)             # k of owned + ghosts
         self.kbase = np.full(nl, self.top, np.uint8)    # before the buffer
         self.kmin = np.zeros(n, np.uint8)               # min k over the closed family
