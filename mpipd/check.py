@@ -48,6 +48,7 @@ BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, 
 #                                 index, volume factor, fallback toggles, ledger row index,
 #                                 the family's finest step class
 MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
+MULTIRATE_OWNED = 8             # the step of each point's last family change (multi-rate only)
 BYTES_PER_BOND = 21             # nbr (int32) + broken (uint8) + omega_i, omega_j (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
@@ -88,6 +89,7 @@ def memory_model(scene) -> tuple[int, int]:
     mr = scene.time.multirate
     if mr is not None:
         local += MULTIRATE_LOCAL_PER_CLASS * (mr.max_ratio.bit_length() - 1)
+        owned += MULTIRATE_OWNED if mr.max_ratio > 1 else 0
     return local, owned
 
 

@@ -205,6 +205,9 @@ class Simulation:
         jump like any other discontinuity: in ``multirate`` when the classes
         changed at this boundary, else in ``removed``."""
         before = self.ledger.integrator(self)
+        # the owned v are now v_{n+1}: the ghosts must hold the same (the viscosity
+        # reads v_j - v_i), or the forces would depend on the decomposition
+        self.halo.exchange(self.v)
         self.compute_forces()
         if self.loads:
             self.apply_loads(self.t + dt, 0.0)
@@ -229,6 +232,7 @@ class Simulation:
         family holds a changed class, and a follows there.  The jump of the
         integrator term is the ledger's ``multirate`` entry."""
         before = self.ledger.integrator(self)
+        self.halo.exchange(self.v)              # v_{n+1} on the ghosts too (as _refresh_forces)
         rows = self.classes.reweighted_rows()
         self.corr.reweight(rows, self.u, self.v, self.f, self.ledger.fv, self.classes.previous)
         a = self.f[rows] * (1.0 / self.rho[rows])[:, None]          # as integrate.kick

@@ -125,9 +125,13 @@ def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
 
 @pytest.fixture(scope="module")
 def multirate_runs(tmp_path_factory):
-    """granite_ring with multi-rate classes (rock class 2, the crushed zone finer)."""
+    """granite_ring with multi-rate classes (rock class 2, the crushed zone finer) and
+    the forces recomputed after breakage (the ghosts' velocities once made that
+    path depend on the decomposition; tests/test_restart.py covers the other one,
+    the re-gather after a class change)."""
     return run_on_1_2_3(tmp_path_factory.mktemp("mr"), "granite_ring",
-                        FRACTURE + ["--set", "time.multirate={max_ratio=4, safety=1.0}"])
+                        FRACTURE + ["--set", "time.multirate={max_ratio=4, safety=1.0}",
+                                    "--set", "solver.refresh_after_break=true"])
 
 
 def test_multirate_identical_on_1_2_3_ranks(multirate_runs, fracture_runs):

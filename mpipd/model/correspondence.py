@@ -150,9 +150,12 @@ class Correspondence(Model):
         computed from them."""
         own, mode = self.name, self.mode
         add = state.add
-        for name in ("Kinv", "trK", "Fdot", "d", "J", "J_end", "toggled", "gamma", "dil",
-                     "hg_modulus"):
+        for name in ("Kinv", "trK", "Fdot", "J", "toggled", "gamma", "dil", "hg_modulus"):
             add(name, own, getattr(self, name))
+        # with step classes a point keeps its last rate and volume between its updates:
+        # the tension check (every step) and the ledger read them, so a restart needs them
+        for name in ("d", "J_end"):
+            add(name, own, getattr(self, name), checkpoint=self.classes.enabled)
         add("spring", own, self.spring, checkpoint=True, restore=REBUILT)
         add("F", own, self.F)
         add("F_old", own, self.F_old, checkpoint=True, restore=LAST)
