@@ -112,6 +112,7 @@ def multirate_pair(case, ratio=4, safety=0.5):
     simulated microsecond and their ratio."""
     def make(n: int, steps: int, multirate: bool = False) -> dict:
         d = case(n, steps)
+        d["output"]["every"] = 4 * ratio           # frames on coarse steps (none are written)
         if multirate:
             d["time"]["multirate"] = {"max_ratio": ratio, "safety": safety}
         return d
