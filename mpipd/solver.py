@@ -157,8 +157,8 @@ class Simulation:
         self.peaks.register(st)
         self.classify()                         # the reference state's classes
         self.initialize()
-        self.probes = (Probes(scene.probes, scene, p, team, self.corr, self.v, self.mode)
-                       if scene.probes else None)
+        self.probes = (Probes(scene.probes, scene, p, team, self.corr, self.v, self.mode,
+                              self.classes.klass) if scene.probes else None)
         self.energies()                         # the ledger's initial energy (step 0)
 
     def initialize(self):

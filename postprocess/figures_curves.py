@@ -63,7 +63,7 @@ def arrivals(ws, label, out) -> str:
     fig, ax = plt.subplots(figsize=(5.6, 3.9))
     d = np.array([a["d_mm"] for a in ws["arrivals"]])
     t = np.array([a["t_us"] for a in ws["arrivals"]])
-    ax.plot(d, t, "o", color="C0", label="first arrival (10 % of the probe's peak)")
+    ax.plot(d, t, "o", color="C0", label="first arrival (10 % of the first pulse's peak)")
     for a in ws["arrivals"]:
         ax.annotate(a["name"], (a["d_mm"], a["t_us"]), textcoords="offset points", xytext=(4, -8))
     pa = ws.get("peak_arrival", {})

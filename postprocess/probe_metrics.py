@@ -17,7 +17,7 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
   whose peak is the last recorded step (the wave has not passed it yet) is shown
   but left out of the fits and of the wave speed.
 * Wave speed (Fig. 16b): from the first arrivals at A–G (:mod:`postprocess.arrivals`:
-  10 % of each probe's peak, arrival times increasing with d, least-squares slope
+  10 % of the peak of each probe's first pulse, arrival times increasing with d, least-squares slope
   of d against t; Table 1's c_P = sqrt((K + 4G/3)/rho) = 4595 m/s), and beside it the
   paper's method, the arrival time of the peak (the largest sample refined by a
   parabola; paper 4270 m/s, measured P-wave speed 4535 m/s), with the probes whose
@@ -43,6 +43,7 @@ from .model import zone_of
 SERIES = {"A": 6.8, "B": 10.8, "C": 22.0, "D": 29.2, "E": 39.6, "F": 50.0, "G": 59.6}
 PATHS = {"P1": 0.8, "P2": 1.6, "P3": 4.8}
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
+OPTIONAL = ("t_state",)         # absent from files written before 2026-12: t_state = t
 YIELD_TOL = 0.99
 ROCK_PROBES = ("wall", *SERIES, *PATHS)
 
@@ -52,8 +53,8 @@ def na(reason: str) -> dict:
 
 
 def load_probes(run, model) -> dict:
-    """name -> {gid, x, d (m), t, sigma_rr, v_r, p, s, strength}; rows never written
-    (NaN) are dropped.  Read by rank 0, broadcast (probes are small)."""
+    """name -> {gid, x, d (m), t, sigma_rr, v_r, p, s, strength, t_state}; rows never
+    written (NaN) are dropped.  Read by rank 0, broadcast (probes are small)."""
     out = None
     if run.root:
         out = {}
@@ -63,6 +64,8 @@ def load_probes(run, model) -> dict:
             if not all(q in g for q in QUANTITIES) or "gid" not in g.attrs:
                 continue
             data = {q: g[q][...] for q in QUANTITIES}
+            for q in OPTIONAL:
+                data[q] = g[q][...] if q in g else data["t"].copy()
             keep = np.isfinite(data["t"])
             data = {q: a[keep] for q, a in data.items()}
             gid = int(g.attrs["gid"])
@@ -125,7 +128,7 @@ def radial_stress(probes) -> dict:
     pts = []
     for n in have:
         q = probes[n]
-        t, pk, interior = fits.peak_time(q["t"], -q["sigma_rr"])
+        t, pk, interior = fits.peak_time(*arrivals.state_samples(q, -q["sigma_rr"]))
         pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": SERIES[n],
                     "peak_MPa": pk / 1e6, "t_peak_us": t * 1e6, "peak_inside_record": interior})
     out = {"points": pts, "missing": missing, "errors": bad}
@@ -153,7 +156,7 @@ def wave_speed(probes, radial: dict) -> dict:
     rows, skipped = [], {}
     for p in pts:
         q = probes[p["name"]]
-        a = arrivals.first_arrival(q["t"], -q["sigma_rr"])
+        a = arrivals.first_arrival(*arrivals.state_samples(q, -q["sigma_rr"]))
         if "not_available" in a:
             skipped[p["name"]] = a["not_available"]
             continue
@@ -185,7 +188,8 @@ def _threshold_study(probes, names, d) -> list[dict]:
     over the probes of the judged fit."""
     out = []
     for frac in arrivals.STUDY:
-        t = [arrivals.first_arrival(probes[n]["t"], -probes[n]["sigma_rr"], frac) for n in names]
+        t = [arrivals.first_arrival(*arrivals.state_samples(probes[n], -probes[n]["sigma_rr"]),
+                                    frac) for n in names]
         row = {"fraction": frac}
         if any("not_available" in a for a in t):
             row["not_available"] = "; ".join(f"{n}: {a['not_available']}"

@@ -216,7 +216,7 @@ def _speeds(w) -> list[str]:
              + f" (paper 4270 m/s); {pa.get('note', '')}.")
     ts = w.get("threshold_study", [])
     if ts:
-        L.append("The same first-arrival speed at other fractions of each probe's peak "
+        L.append("The same first-arrival speed at other fractions of each probe's first-pulse peak "
                  "(information; equal for pulses that keep their shape): " + ", ".join(
                      f"{r['fraction'] * 100:g} % " + (f"{r['speed_m_s']:.0f} m/s" if "speed_m_s" in r
                                                      else "error" if "error" in r else "n/a")

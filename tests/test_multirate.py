@@ -172,3 +172,39 @@ def test_state_following_classes_and_the_ledger():
     assert bal < 1e-4                            # measured 3.1e-5 (single-rate: 1.7e-6)
     # the multirate term is needed: without it the ledger would not close to the bound
     assert abs(e.multirate) / e.scale > 1e-3     # measured 2.2e-3
+
+
+def test_a_probe_in_a_coarse_class_is_timed_at_its_updates():
+    """A probe in the coarse half (class 2 of ratio 4) records every fine step, but its
+    stress changes only at its class's updates: t_state = t - (n mod 4) dt, the stress
+    is constant between updates, and the first arrival timed on one sample per state
+    (postprocess.arrivals.state_samples) matches the single-rate probe's, where the
+    staircase timed at the recording steps comes late."""
+    from postprocess.arrivals import first_arrival, state_samples
+    dt, t_end = 2.5e-8, 1.2e-5
+    probe = ["probes=[{name='C', position=[0.07, 0.003, 0.003]}]"]
+    rec = {}
+    for ratio in (None, 4):
+        over = BAR + probe + [f"time.dt={dt}", f"time.t_end={t_end}"]
+        if ratio:
+            over.append(f"time.multirate={{max_ratio={ratio}, safety=1.0}}")
+        scene, _ = sc.load("elastic_wave", over)
+        sim = Simulation(scene, _team())
+        if ratio:
+            n = sim.points.n_owned
+            sim.hold_classes(np.where(sim.points.x[:n, 0] < 0.04, 0, 2).astype(np.uint8))
+        sim.run(scene.time.n_steps)
+        (k, rows), = sim.probes.rows.items()
+        a = np.array(rows)
+        rec[ratio] = {"t": a[:, 0], "sigma_rr": a[:, 1], "t_state": a[:, 6]}
+    sr, mr = rec[None], rec[4]
+    steps = np.rint(mr["t"] / dt).astype(int)
+    assert np.array_equal(sr["t_state"], sr["t"])
+    assert np.allclose(mr["t_state"], mr["t"] - (steps % 4) * dt, rtol=0, atol=1e-15)
+    held = steps % 4 != 0
+    assert np.array_equal(mr["sigma_rr"][held], mr["sigma_rr"][np.flatnonzero(held) - 1])
+    t_sr = first_arrival(sr["t"], -sr["sigma_rr"])["t_s"]
+    t_raw = first_arrival(mr["t"], -mr["sigma_rr"])["t_s"]
+    t_state = first_arrival(*state_samples(mr, -mr["sigma_rr"]))["t_s"]
+    assert abs(t_state - t_sr) < 0.5 * dt                 # measured 0.09 dt
+    assert t_raw - t_sr > 1.0 * dt                        # measured 2.16 dt late

@@ -13,8 +13,12 @@ that owns it records, every step,
     s                           von Mises equivalent stress
     strength                    JH2 yield strength sigma_y at the point's p*, edot*, D
                                 (NaN for other materials)
+    t_state                     the time of the state its stress was taken at: t in
+                                the fine class; under multi-rate, a point of class k
+                                at step n was last updated at step n - (n mod 2^k)
+                                (docs/multirate.md), so t_state = t - (n mod 2^k) dt
 
-into ``/probes/<name>/{t, sigma_rr, v_r, p, s, strength}``, with ``/probes/<name>``
+into ``/probes/<name>/{t, sigma_rr, v_r, p, s, strength, t_state}``, with ``/probes/<name>``
 attributes ``gid``, ``position`` (requested), ``x`` (the chosen point), ``distance``
 (m, from the requested position to the chosen point), ``part`` (the zone holding
 the point), ``material`` and ``requested_part`` (the probe's ``part``, "" if none).
@@ -29,7 +33,7 @@ import numpy as np
 
 from ..input.schema import fail
 
-QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
+QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength", "t_state")
 
 
 @dataclass(frozen=True)
@@ -48,12 +52,14 @@ def part_matches(part: str, name: str) -> bool:
 
 
 class Probes:
-    def __init__(self, probes, scene, points, team, corr, v, mode):
+    def __init__(self, probes, scene, points, team, corr, v, mode, klass):
         """``probes``: the scene's; ``corr``: the correspondence model (stress of a
-        point, material groups); ``v`` and ``mode``: the State's velocities and
-        failure flags.  Collective (the nearest point is found over all ranks)."""
+        point, material groups); ``v``, ``mode`` and ``klass``: the State's velocities,
+        failure flags and step classes.  Collective (the nearest point is found over
+        all ranks)."""
         self.probes = list(probes)
         self.team, self.corr, self.v, self.mode = team, corr, v, mode
+        self.klass, self.dt = klass, scene.time.dt
         self.points = points
         n = points.n_owned
         x = points.x[:n]
@@ -133,7 +139,8 @@ class Probes:
             seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
             if not self.rows[k]:
                 self.start[k] = step
-            row = (t, srr, vr, p, seq, self._strength(i))
+            lag = step % (1 << int(self.klass[i]))      # fine steps since its update
+            row = (t, srr, vr, p, seq, self._strength(i), t - lag * self.dt)
             self.rows[k].append(row)
             pk = self.peak[k]
             pk[0], pk[1], pk[2] = min(pk[0], srr), max(pk[1], abs(vr)), max(pk[2], p)
