@@ -35,13 +35,14 @@ CASE = HERE / "verify_case.py"
 
 #: problems in table order; "serial": a material point, run on 1 rank only
 PROBLEMS = [("wave", False), ("lame", False), ("energy", False), ("jh2_point", True),
-            ("detonation", False), ("isentrope_dt", False), ("wave_multirate", False)]
+            ("detonation", False), ("isentrope_dt", False), ("wave_multirate", False),
+            ("borehole_multirate", False)]
 
 #: problems --quick runs on 1 rank only (the detonation run already covers the gas on 2)
 QUICK_SERIAL_ONLY = {"isentrope_dt"}
 
 #: problems --quick leaves out (tests/test_multirate.py runs the class boundary in make test)
-QUICK_SKIP = {"wave_multirate"}
+QUICK_SKIP = {"wave_multirate", "borehole_multirate"}
 
 
 def child_env() -> dict:

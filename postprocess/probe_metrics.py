@@ -203,17 +203,20 @@ def _threshold_study(probes, names, d) -> list[dict]:
 
 
 def _peak_arrival(pts, later) -> dict:
-    """The paper's method: slope of d against the arrival time of each probe's peak."""
+    """The paper's method: slope of d against the arrival time of each probe's peak.
+    Peak times that do not increase with distance give no speed (a slope through
+    them is not a wave speed: it came out negative or above 10 km/s), but
+    ``not_available`` with the probes out of order."""
     note = ("peak is a later pulse than the first (a reflection): " + ", ".join(later)
             if later else "every probe's peak lies in its first pulse")
-    try:
-        f = fits.line([p["t_peak_us"] * 1e-6 for p in pts], [p["d_mm"] * 1e-3 for p in pts])
-    except fits.FitError as e:
-        return {"not_available": str(e), "later_pulse": later, "note": note}
-    return {"speed_m_s": f["slope"], "r2": f["r2"], "probes": [p["name"] for p in pts],
-            "later_pulse": later, "note": note,
-            "arrivals": [{"name": p["name"], "d_mm": p["d_mm"], "t_us": p["t_peak_us"]}
-                         for p in pts]}
+    names = [p["name"] for p in pts]
+    f = arrivals.speed(names, [p["d_mm"] * 1e-3 for p in pts], [p["t_peak_us"] * 1e-6 for p in pts])
+    rows = [{"name": p["name"], "d_mm": p["d_mm"], "t_us": p["t_peak_us"]} for p in pts]
+    if "speed_m_s" not in f:
+        why = f.get("error", f.get("not_available", "")).replace("first-arrival", "peak")
+        return {"not_available": why, "later_pulse": later, "note": note, "arrivals": rows}
+    return {"speed_m_s": f["speed_m_s"], "r2": f["r2"], "probes": names,
+            "later_pulse": later, "note": note, "arrivals": rows}
 
 
 def ppv(probes) -> dict:

@@ -16,6 +16,7 @@ key             module                problem
 ``detonation``  :mod:`.detonation`    explosive column in a copper tube
 ``isentrope_dt`` :mod:`.detonation`   the same at one dx with dt refined alone
 ``wave_multirate`` :mod:`.wave_multirate` the plane wave across a multi-rate class boundary
+``borehole_multirate`` :mod:`.borehole_multirate` a borehole pressure pulse across one
 ==============  ====================  ==============================================
 
 :mod:`.common` holds what they share (the paper's granite, scene building, the
@@ -25,6 +26,7 @@ Two hooks reach past the scene file, both in this harness only: the wave's later
 rollers (the solver has no per-component boundary condition) and the Lame
 cylinder's global damping (the solver's damping acts on failed points only).
 """
+from .borehole_multirate import BoreholeMultirate
 from .detonation import Detonation, IsentropeDt
 from .energy import Energy
 from .jh2_point import JH2Point
@@ -34,4 +36,4 @@ from .wave_multirate import WaveMultirate
 
 PROBLEMS = {"wave": Wave, "lame": Lame, "energy": Energy, "jh2_point": JH2Point,
             "detonation": Detonation, "isentrope_dt": IsentropeDt,
-            "wave_multirate": WaveMultirate}
+            "wave_multirate": WaveMultirate, "borehole_multirate": BoreholeMultirate}
