@@ -20,7 +20,9 @@ References, both computed here:
   stress between updates) and interpolated onto the single-rate times; and the
   difference of the first arrivals (``postprocess.arrivals``) in units of dt.
 
-Each row also gives the ledger's largest |balance| over the run.
+Each row also gives the ledger's largest |balance| at the coarse steps after the first
+µs (before it the load has put in almost nothing, and the balance, relative to the
+energy put in, means nothing; single-rate then stays within 2e-6).
 """
 from __future__ import annotations
 
@@ -75,7 +77,8 @@ class BoreholeMultirate:
     QUICK = (2.0e-3,)                 # not in --quick (verify.QUICK_SKIP)
 
     def run(self, team, dx, steps=None):
-        from benchmarks.diagnoses.wave_speed import closed_form
+        from diagnoses.wave_speed import closed_form
+
         from mpipd.input.loads import BoreholePressure
         from postprocess.arrivals import first_arrival, state_samples
         rows, ref = [], None
@@ -94,7 +97,7 @@ class BoreholeMultirate:
                 sim.step()
                 if sim.probes is not None:
                     sim.probes.sample(sim.step_count, sim.t)
-                if sim.at_boundary:
+                if sim.at_boundary and sim.t >= 1e-6:
                     bal = max(bal, abs(sim.energies().balance))
             sim.check_finite()
             wall = tm.stop()
@@ -120,7 +123,8 @@ class BoreholeMultirate:
                    "error": max(errs), "value": max(errs), "reference": 0.0,
                    "value_name": "peak error", "balance": bal}
             if ratio > 1:
-                row["record_diff_vs_single_rate"] = max(diff)
-                row["arrival_shift_dt"] = max(arr, key=abs) / DT
+                row.update(record_diff_vs_single_rate=max(diff), value=max(diff),
+                           value_name="records vs single-rate",
+                           arrival_shift_dt=max(arr, key=abs) / DT)
             rows.append(row)
         return None if steps is not None else rows
