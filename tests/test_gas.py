@@ -272,3 +272,46 @@ def test_gas_past_its_slab_sees_the_same_solids_on_1_2_3_ranks(tmp_path):
             for k, a in ref.items():
                 assert np.array_equal(f[k][...], a), f"{k} differs between 1 and {n} ranks"
     assert ref["fields/pressure"][-1].max() > 1e9                # the charge is burning
+
+
+def _brute_pairs(y, rows, el, h, skin, gid, n):
+    """Every (i in rows, j in el), i != j, closer than max(h_i, h_j) + skin, each row
+    in gid order: the definition, by a double loop."""
+    fam = {}
+    for i in rows:
+        js = [j for j in el if j != i
+              and np.linalg.norm(y[j] - y[i]) < max(h[i], h[j]) + skin]
+        fam[int(i)] = sorted(js, key=lambda j: gid[j])
+    return fam
+
+
+@pytest.mark.parametrize("spread", [1.0, 40.0])
+def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
+    """Random points (gas with a horizon, solids with none), some rows; clustered, and
+    spread over many empty cells: the cell list gives the pairs of the definition,
+    each row sorted by gid, and so does the k-d tree it falls back to."""
+    from mpipd.kernels.search import cell_counts, cell_pairs
+    rng = np.random.default_rng(7)
+    n_local, n = 900, 600
+    y = rng.uniform(0.0, 0.01, (n_local, 3))
+    y[::7] *= spread                                   # some far away
+    gid = rng.permutation(n_local).astype(np.int64)
+    h = np.where(rng.random(n_local) < 0.5, 1.5e-3, 0.0)
+    skin = 0.3e-3
+    el = np.flatnonzero(rng.random(n_local) < 0.8)
+    rows = el[el < n]
+    cell = h.max() + skin
+    lo, dims = cell_counts(y[el], cell)
+    counts, nbr = cell_pairs(y, rows, el, h, skin, cell, lo, dims, gid, n)
+    want = _brute_pairs(y, rows, el, h, skin, gid, n)
+    off = np.concatenate(([0], np.cumsum(counts)))
+    assert counts.sum() == sum(len(v) for v in want.values()) > 0
+    for i in range(n):
+        assert list(nbr[off[i]:off[i + 1]]) == want.get(i, [])
+    from types import SimpleNamespace
+
+    from mpipd.model.gas import Gas
+    gas = SimpleNamespace(rows=rows, eligible=el, reach=h.max(), skin=skin, gas_horizon=h,
+                          points=SimpleNamespace(gid=gid))
+    c2, n2 = Gas._tree_pairs(gas, y, n)
+    assert np.array_equal(c2, counts) and np.array_equal(n2, nbr)

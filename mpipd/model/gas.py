@@ -11,7 +11,8 @@ material.
   and the ``interacts_with`` solids within the gas horizon; for each owned such
   solid, the gas points whose horizon reaches it.  No total-Lagrangian bond
   touches a gas point, and there are no gas-rock bonds unless the scene lists
-  the rock.  They are searched with a cKDTree out to the horizon plus a skin
+  the rock.  They are searched with a cell list (mpipd.kernels.search; a cKDTree
+  if the points spread too far for its keys) out to the horizon plus a skin
   (Verlet list, SKIN x the gas horizon) and searched again only once some
   eligible point has moved more than half the skin since: until then every pair
   within the horizon is in the list.  The kernels keep only pairs inside the
@@ -30,6 +31,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
+from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs
 from ..kernels.ul import gas_gather, gas_update
 from ..state import AUX, LOCAL
 from .base import Model
@@ -132,16 +134,27 @@ class Gas(Model):
         self.y_built = y[el]
         self.searches += 1
         if len(self.rows) and len(el):
-            m = cKDTree(y[self.rows]).sparse_distance_matrix(
-                cKDTree(y[el]), self.reach + self.skin, output_type="ndarray")
-            i, j = self.rows[m["i"]], el[m["j"]]
-            h = self.gas_horizon
-            keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
-            counts, self.nbr = _csr_by_row(i[keep], j[keep], p.gid, n)
+            cell = self.reach + self.skin
+            lo, dims = cell_counts(y[el], cell)
+            if float(np.prod(dims.astype(float))) < MAX_CELLS:
+                counts, self.nbr = cell_pairs(y, self.rows, el, self.gas_horizon, self.skin,
+                                              cell, lo, dims, p.gid, n)
+            else:                               # spread too far for int64 cell keys
+                counts, self.nbr = self._tree_pairs(y, n)
             self.offsets[1:] = np.cumsum(counts)
         else:
             self.offsets[:] = 0
         self.search_seconds += time.perf_counter() - t0
+
+    def _tree_pairs(self, y, n):
+        """The same pairs by a k-d tree (points spread beyond the cell keys' range)."""
+        el = self.eligible
+        m = cKDTree(y[self.rows]).sparse_distance_matrix(
+            cKDTree(y[el]), self.reach + self.skin, output_type="ndarray")
+        i, j = self.rows[m["i"]], el[m["j"]]
+        h = self.gas_horizon
+        keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
+        return _csr_by_row(i[keep], j[keep], self.points.gid, n)
 
     def update(self, u, v, dt: float, t: float):
         """Families, then volume, energy, pressure and force data of the owned gas."""
