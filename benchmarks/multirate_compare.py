@@ -3,7 +3,8 @@
     python benchmarks/multirate_compare.py --out FILE.md LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 
 Each RUN_DIR holds ``run.h5`` and, for the target rows, ``report/report.json``
-(``python -m postprocess report``; without it the table has the run rows only).
+(``python -m postprocess report``; without it the table has the run rows only), or
+only a ``report.json`` (a run whose file is elsewhere: ``docs/validation/<case>/``).
 The first run is the reference.  The table gives, for every run:
 
 * its commit, ranks and loop wall time (run.h5 ``segments``);
@@ -36,6 +37,8 @@ import numpy as np
 
 
 def read(run_dir: Path) -> dict:
+    if not (run_dir / "run.h5").exists() and (run_dir / "report.json").exists():
+        return read_report(run_dir / "report.json")
     with h5py.File(run_dir / "run.h5", "r") as f:
         seg = json.loads(f.attrs["segments"])
         out = {"commit": str(f.attrs["git_commit"])[:12], "ranks": int(f.attrs["ranks"]),
@@ -48,6 +51,22 @@ def read(run_dir: Path) -> dict:
     out["targets"] = ([(t["label"], t.get("unit", ""), t.get("value"))
                        for t in json.loads(rep.read_text())["targets"]] if rep.exists() else [])
     return out
+
+
+def read_report(path: Path) -> dict:
+    """The same rows from a report.json alone (a run whose run file is not on this
+    machine, e.g. docs/validation/<case>/report.json): its ``run`` block, failure
+    modes and ledger."""
+    j = json.loads(path.read_text())
+    run, fm = j["run"], j["failure_modes"]
+    modes = [fm.get(k, 0) for k in ("intact", "JH2 plastic (D >= 1)", "JH2 tensile (p < -T)",
+                                     "tension model (Eq. 38)")]
+    return {"commit": str(run["git_commit"])[:12], "ranks": int(run["run_ranks"]),
+            "wall": sum(s["wall_s"] for s in run.get("segments", [])), "dt": float(run["dt_s"]),
+            "modes": modes, "broken": int(run["bonds_broken"]),
+            "balance": float(j["energy_ledger"]["balance"][-1]),
+            "multirate": float(j["energy_ledger"]["final_J"].get("multirate", 0.0)),
+            "targets": [(t["label"], t.get("unit", ""), t.get("value")) for t in j["targets"]]}
 
 
 def pct(v, ref):
