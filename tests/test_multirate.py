@@ -23,10 +23,11 @@ def _team():
     return Team(MPI.COMM_SELF)
 
 
-def bar(dt, t_end, ratio=None, coarse=None, x_split=0.04):
-    """The elastic bar; with ``ratio``, class 0 for x < x_split and ``coarse`` beyond
-    (all points ``coarse`` if x_split is None), held there at every boundary."""
-    over = BAR + [f"time.dt={dt}", f"time.t_end={t_end}"]
+def bar(dt, t_end, ratio=None, coarse=None, x_split=0.04, extra=()):
+    """The elastic bar (``extra``: more overrides); with ``ratio``, class 0 for
+    x < x_split and ``coarse`` beyond (all points ``coarse`` if x_split is None),
+    held there at every boundary."""
+    over = BAR + list(extra) + [f"time.dt={dt}", f"time.t_end={t_end}"]
     if ratio:
         over.append(f"time.multirate={{max_ratio={ratio}, safety=1.0}}")
     scene, _ = sc.load("elastic_wave", over)
@@ -185,14 +186,7 @@ def test_a_probe_in_a_coarse_class_is_timed_at_its_updates():
     probe = ["probes=[{name='C', position=[0.07, 0.003, 0.003]}]"]
     rec = {}
     for ratio in (None, 4):
-        over = BAR + probe + [f"time.dt={dt}", f"time.t_end={t_end}"]
-        if ratio:
-            over.append(f"time.multirate={{max_ratio={ratio}, safety=1.0}}")
-        scene, _ = sc.load("elastic_wave", over)
-        sim = Simulation(scene, _team())
-        if ratio:
-            n = sim.points.n_owned
-            sim.hold_classes(np.where(sim.points.x[:n, 0] < 0.04, 0, 2).astype(np.uint8))
+        scene, sim = bar(dt, t_end, ratio=ratio, coarse=2, extra=probe)
         sim.run(scene.time.n_steps)
         (k, rows), = sim.probes.rows.items()
         a = np.array(rows)

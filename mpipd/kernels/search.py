@@ -55,15 +55,23 @@ def _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, nbr, 
                                 k += 1
                             else:
                                 counts[i] += 1
-        if fill and k - start[i] > 1:
-            a = start[i]
-            row = nbr[a:k].copy()
-            keys = np.empty(k - a, gid.dtype)
-            for m in range(k - a):
-                keys[m] = gid[row[m]]
-            srt = np.argsort(keys)
-            for m in range(k - a):
-                nbr[a + m] = row[srt[m]]
+        if fill:
+            sort_row_by_gid(nbr, start[i], k, gid)
+
+
+@numba.njit(cache=True)
+def sort_row_by_gid(nbr, a, b, gid):
+    """Sort nbr[a:b] (local indices) by their gids (distinct in a row, so the order is
+    the one any sort gives)."""
+    if b - a < 2:
+        return
+    row = nbr[a:b].copy()
+    keys = np.empty(b - a, gid.dtype)
+    for m in range(b - a):
+        keys[m] = gid[row[m]]
+    srt = np.argsort(keys)
+    for m in range(b - a):
+        nbr[a + m] = row[srt[m]]
 
 
 @numba.njit(cache=True)

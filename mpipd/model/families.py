@@ -24,6 +24,7 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..kernels.search import sort_row_by_gid
 from ..state import AUX, BOND
 
 
@@ -62,16 +63,7 @@ def _csr_by_row(i, j, gid, n_rows):
         nbr[fill[i[k]]] = j[k]
         fill[i[k]] += 1
     for r in range(n_rows):
-        a, b = start[r], start[r + 1]
-        if b - a < 2:
-            continue
-        row = nbr[a:b].copy()
-        keys = np.empty(b - a, gid.dtype)
-        for q in range(b - a):
-            keys[q] = gid[row[q]]
-        order = np.argsort(keys)
-        for q in range(b - a):
-            nbr[a + q] = row[order[q]]
+        sort_row_by_gid(nbr, start[r], start[r + 1], gid)
     return counts, nbr
 
 
