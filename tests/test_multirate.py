@@ -9,7 +9,7 @@ import pytest
 
 from mpipd.input import scene as sc
 from mpipd.input.schema import SceneError
-from mpipd.model.multirate import level_at, projected_cost
+from mpipd.model.multirate import level_at, projected_cost, steps_since_update
 from mpipd.solver import Simulation, Unstable
 
 BAR = ["parts.0.shape.hi=[0.096, 0.006, 0.006]", "output.every=8"]
@@ -68,6 +68,12 @@ def test_level_schedule():
     assert [level_at(s, 8) for s in range(1, 9)] == [0, 1, 0, 2, 0, 1, 0, 3]
     assert [level_at(s, 1) for s in range(1, 5)] == [0, 0, 0, 0]
     assert projected_cost([10, 0, 90]) == pytest.approx(0.1 + 90 / 4 / 100)
+    # class 2 of ratio 4 is updated at steps 4, 8, ...: 3 steps after step 4 at step 7
+    assert [steps_since_update(s, 2) for s in range(4, 9)] == [0, 1, 2, 3, 0]
+    for ratio in (2, 4, 8):
+        for k in range(ratio.bit_length()):
+            for s in range(1, 4 * ratio + 1):   # updated exactly where the level reaches k
+                assert (steps_since_update(s, k) == 0) == (level_at(s, ratio) >= k)
 
 
 @pytest.mark.parametrize("override,key,word", [

@@ -73,6 +73,13 @@ def level_at(step: int, ratio: int) -> int:
     return (s & -s).bit_length() - 1
 
 
+def steps_since_update(step: int, k: int) -> int:
+    """Fine steps since a class-k point's state was last updated, at the end of step
+    ``step``: class k is updated at the steps that are multiples of 2^k (the same
+    schedule as :func:`level_at`: level_at(step) >= k exactly there)."""
+    return step % (1 << k)
+
+
 class StepClasses:
     """Step class of every local point (owned first, ghosts after), the coarse-step
     bookkeeping and the rows each level updates.  Single-rate scenes hold all

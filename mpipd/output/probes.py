@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..input.schema import fail
+from ..model.multirate import steps_since_update
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength", "t_state")
 
@@ -139,7 +140,7 @@ class Probes:
             seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
             if not self.rows[k]:
                 self.start[k] = step
-            lag = step % (1 << int(self.klass[i]))      # fine steps since its update
+            lag = steps_since_update(step, int(self.klass[i]))
             row = (t, srr, vr, p, seq, self._strength(i), t - lag * self.dt)
             self.rows[k].append(row)
             pk = self.peak[k]
