@@ -29,6 +29,7 @@ import time as _time
 import numpy as np
 
 from .input.geometry import LayerTable
+from .input.joints import cut_joints
 from .kernels import integrate, runaway
 from .kernels.layout import N_MODES
 from .model.base import Model
@@ -74,6 +75,9 @@ class Simulation:
         self.families = build_families(p.x, p.gid, p.horizon, p.n_owned,
                                        tl=self.tl if gas_parts else None)
         self.n_bonds_global = team.sum(self.families.n_bonds)
+        # pre-existing joints: their crossing bonds start broken (before K is built)
+        self.joint_bonds = team.sum(cut_joints(scene.joints, scene.parts, p, self.families,
+                                               self.tl)) if scene.joints else 0
 
         n = p.n_owned
         names = list(scene.materials)
@@ -355,6 +359,12 @@ class Simulation:
             raise Unstable(f"{what} at step {self.step_count} (t = {self.t:.4e} s), "
                            f"first at gid {gid}, x = ({x[0]:.4g}, {x[1]:.4g}, {x[2]:.4g}) m; "
                            "compare dt with `mpipd check`")
+
+    def geometry_fields(self) -> dict:
+        """Per-point fields of the reference state the run file keeps under
+        /geometry (owned rows): the strength factors of a heterogeneous material."""
+        sf = self.corr.strength_factors()
+        return {} if sf is None else {"strength_factor": sf}
 
     def bonds_broken(self) -> int:
         return self.team.sum(self.failure.bonds_broken) if self.failure else 0

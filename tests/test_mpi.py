@@ -123,6 +123,40 @@ def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
                 assert np.array_equal(f[k][...], a), f"{k} differs between 1 and {n} ranks"
 
 
+ROCKMASS = FRACTURE + [
+    "--set", 'materials.granite.heterogeneity={distribution="weibull", modulus=6.0, seed=2, '
+             'applies_to=["tension", "T"]}',
+    "--set", "parts.0.jitter=0.2", "--set", "parts.0.jitter_seed=3",
+    "--set", "joints=[{point=[0.0, 0.0, 0.0], normal=[1.0, 2.0, 0.5], radius=0.012}, "
+             "{point=[0.0, 0.0, 0.0021], normal=[0.0, 0.0, 1.0], persistence=0.6, patch=0.002}]"]
+
+
+@pytest.fixture(scope="module")
+def rockmass_runs(tmp_path_factory):
+    """granite_ring as a rock mass: Weibull strength, jitter (through the slab cuts) and
+    two joints, one across every slab boundary and one along z."""
+    return run_on_1_2_3(tmp_path_factory.mktemp("rockmass"), "granite_ring", ROCKMASS)
+
+
+def test_rockmass_identical_on_1_2_3_ranks(rockmass_runs, fracture_runs):
+    keys = ("geometry/x", "geometry/strength_factor", "fields/u", "fields/v", "fields/damage",
+            "fields/failure_mode", "probes/near/sigma_rr", "probes/near/strength")
+    with h5py.File(rockmass_runs[1], "r") as f1:
+        ref = {k: f1[k][...] for k in keys}
+        broken, joint = f1.attrs["bonds_broken"], f1.attrs["joint_bonds"]
+    with h5py.File(fracture_runs[1], "r") as f:            # the rock mass is not the lattice
+        assert not np.array_equal(f["geometry/x"][...], ref["geometry/x"])
+        assert f.attrs["joint_bonds"] == 0
+    assert broken > 1000 and joint > 1000
+    assert ref["fields/damage"][0].max() > 0.2             # the joints show at t = 0
+    assert 0.17 < ref["geometry/strength_factor"].std() < 0.22     # m = 6: cv 0.188
+    for n in (2, 3):
+        with h5py.File(rockmass_runs[n], "r") as f:
+            assert f.attrs["bonds_broken"] == broken and f.attrs["joint_bonds"] == joint
+            for k in keys:
+                assert np.array_equal(f[k][...], ref[k]), f"{k} differs between 1 and {n} ranks"
+
+
 @pytest.fixture(scope="module")
 def multirate_runs(tmp_path_factory):
     """granite_ring with multi-rate classes (rock class 2, the crushed zone finer) and

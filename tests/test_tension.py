@@ -43,21 +43,26 @@ def uniaxial(s, edot):
 
 
 @pytest.mark.parametrize("edot", [0.1, 50.0, 2000.0])
-def test_point_fails_exactly_at_dynamic_strength(edot):
+@pytest.mark.parametrize("factor", [None, 0.6])
+def test_point_fails_exactly_at_dynamic_strength(edot, factor):
+    """Eq. 38 by hand: sigma_dt = (edot / edot_0)^C1 sigma_st above edot_0, times a
+    heterogeneous point's strength factor."""
     model = TensionFailure()
-    limit = -dynamic_strength(edot, model.sigma_st, model.c1, model.rate0)   # tension-positive
+    f = 1.0 if factor is None else factor
+    limit = 6.9e6 * f * (edot / 0.4) ** 0.33 if edot > 0.4 else 6.9e6 * f   # tension-positive
+    fac = np.ones(0) if factor is None else np.array([factor])
     for s, fails in ((limit * (1 - 1e-9), False), (limit * (1 + 1e-9), True)):
         sigma, d = uniaxial(s, edot)
         mode = np.zeros(1, np.uint8)
         n = tension_check(np.zeros(1, np.int64), sigma, d, mode, model.sigma_st, model.c1,
-                          model.rate0)
+                          model.rate0, fac)
         assert (n == 1) == fails and (mode[0] == 3) == fails
         if fails:
             assert np.all(sigma == 0.0)
     # compression never fails it
     sigma, d = uniaxial(-10 * limit, edot)
     mode = np.zeros(1, np.uint8)
-    assert tension_check(np.zeros(1, np.int64), sigma, d, mode, -6.9e6, 0.33, 0.4) == 0
+    assert tension_check(np.zeros(1, np.int64), sigma, d, mode, -6.9e6, 0.33, 0.4, fac) == 0
 
 
 def test_rate_of_the_test_is_eq24():

@@ -19,9 +19,12 @@ C_BAR = math.sqrt(9 * K * G / (3 * K + G) / RHO)
 STATIONS = (0.08, 0.12, 0.16)
 
 
-@pytest.fixture(scope="module")
-def wave(team):
-    over = ["parts.0.dx=0.002", "time.dt=2e-7", "time.t_end=4.4e-5", "initial.0.half_width=0.04"]
+@pytest.fixture(scope="module", params=[0.0, 0.2], ids=["lattice", "jitter0.2"])
+def wave(team, request):
+    """The wave on the cubic lattice and on a lattice jittered by 0.2 dx (the rock
+    mass's irregular families: mpipd.input.geometry)."""
+    over = ["parts.0.dx=0.002", "time.dt=2e-7", "time.t_end=4.4e-5", "initial.0.half_width=0.04",
+            f"parts.0.jitter={request.param}"]
     scene, _ = sc.load("elastic_wave", over)
     sim = Simulation(scene, team)
     n = sim.points.n_owned

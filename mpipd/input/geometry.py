@@ -13,6 +13,16 @@ generates only the layers it owns or needs as ghosts.
 
 Within a layer, points are ordered by (y, x); global ids run over layers in
 (z, material, part) order, so gids follow (z, material, y, x).
+
+Jitter.  A part with ``jitter = a`` (0 <= a < 1/2) moves each of its points off
+its lattice site by a uniform offset in [-a dx, a dx] on each axis, drawn from
+(``jitter_seed``, axis, gid) by mpipd.kernels.hashrng — the same on every rank
+count.  A point whose moved position would leave its part (outside the
+cross-section, or beyond the part's z range) stays on its site, so the part's
+points stay inside it; volumes stay dx^3 and the point keeps its layer (its gid
+and owner), so a point may sit up to a dx off its layer's z: the halo of
+mpipd.parallel.decomp grows by twice the largest a dx to cover that.  Two
+points are at least (1 - 2a) dx apart.
 """
 from __future__ import annotations
 
@@ -20,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels.hashrng import STREAM_JITTER, uniform
 from .schema import Registry, fail, join, ordered_box, positive
 
 SHAPES = Registry("shape", "kind")
@@ -223,12 +234,27 @@ def fill_layers(parts, table: LayerTable, layers: np.ndarray):
         x[:, 0] = sx
         x[:, 1] = sy
         x[:, 2] = table.z[L]
+        gid = table.start[L] + np.arange(n, dtype=np.int64)
+        if parts[p].jitter > 0.0:
+            x = jittered(parts[p], x, gid)
         xs.append(x)
         ps.append(np.full(n, p, dtype=np.int32))
-        gs.append(table.start[L] + np.arange(n, dtype=np.int64))
+        gs.append(gid)
     if not xs:
         return np.empty((0, 3)), np.empty(0, np.int32), np.empty(0, np.int64)
     return np.concatenate(xs), np.concatenate(ps), np.concatenate(gs)
+
+
+def jittered(part, x: np.ndarray, gid: np.ndarray) -> np.ndarray:
+    """The part's points ``x`` (lattice sites, global ids ``gid``) moved by its jitter
+    (module docstring); points whose move would leave the part stay on their sites."""
+    a = part.jitter * part.dx
+    off = np.stack([a * (2.0 * uniform(part.jitter_seed, STREAM_JITTER + k, gid) - 1.0)
+                    for k in range(3)], axis=1)
+    y = x + off
+    z0, z1 = part.shape.z_range
+    keep = part.shape.contains_xy(y[:, 0], y[:, 1], 0.0) & (y[:, 2] > z0) & (y[:, 2] < z1)
+    return np.where(keep[:, None], y, x)
 
 
 def _sphere_directions(n: int) -> np.ndarray:

@@ -8,13 +8,16 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [materials.NAME]  model = "elastic", density, bulk_modulus, shear_modulus
     [[parts]]     name, material, dx (m), horizon_factor (default 3.0),
                   shape = { kind = "box" | "cylinder" | "annulus", ... },
-                  influence = "quadratic" (default) | "constant" | "inverse"
+                  influence = "quadratic" (default) | "constant" | "inverse",
+                  jitter = 0.2, jitter_seed = 1 (lattice jitter, mpipd.input.geometry)
     [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity" | "gaussian_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
     [[probes]]    name, position, center (radial axis), part (snap to that part's
                   points only): recorded every step
+    [[joints]]    point, normal, radius, spacing, persistence, patch, seed, parts:
+                  pre-existing joints whose crossing bonds start broken (mpipd.input.joints)
     [output]      every (steps), fields
 
 Horizon.  A part's horizon is delta = horizon_factor * dx * (1 + HORIZON_TOL)
@@ -46,6 +49,7 @@ from ..kernels.influence import CODES as INFLUENCE
 from ..materials import MATERIALS
 from ..output.probes import Probe, part_matches
 from .geometry import SHAPES
+from .joints import Joint
 from .loads import BOUNDARIES, INITIAL, LOADS
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
@@ -162,9 +166,15 @@ class Part:
     grade: Grade | None = None
     band: Band | None = None
     influence: str = "quadratic"
+    jitter: float = 0.0               # lattice jitter, fraction of dx (mpipd.input.geometry)
+    jitter_seed: int = 1
 
     def check(self, path):
         positive(self, path, "dx")
+        if not 0.0 <= self.jitter < 0.5:
+            fail(join(path, "jitter"), f"must be in [0, 0.5): the offset on each axis is at "
+                                       f"most jitter * dx (got {self.jitter})")
+        non_negative(self, path, "jitter_seed")
         if self.influence not in INFLUENCE:
             fail(join(path, "influence"), f"unknown influence function {self.influence!r} "
                                           f"(known: {', '.join(INFLUENCE)})")
@@ -286,6 +296,7 @@ class Scene:
     boundaries: tuple = tagged(BOUNDARIES, list, default=())
     loads: tuple = tagged(LOADS, list, default=())
     probes: tuple[Probe, ...] = ()
+    joints: tuple[Joint, ...] = ()
     output: Output = field(default_factory=Output)
 
     def __post_init__(self):
@@ -319,6 +330,11 @@ class Scene:
         for i, ld in enumerate(self.loads):
             if hasattr(ld, "check_parts"):          # loads placed on the geometry
                 ld.check_parts(self.parts, f"loads[{i}]")
+        for i, jt in enumerate(self.joints):
+            jt.check_parts(self.parts, f"joints[{i}]")
+        if self.joints and not self.solver.contact:
+            fail("solver.contact", "joints need contact (true): the faces of a joint "
+                                   "would otherwise pass through each other")
         seen = set()
         for i, pr in enumerate(self.probes):
             if pr.name in seen or not pr.name.isidentifier():

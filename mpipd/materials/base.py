@@ -6,7 +6,7 @@ import math
 import numba
 import numpy as np
 
-from ..input.schema import positive
+from ..input.schema import fail, join, positive
 
 
 @numba.njit(cache=True)
@@ -31,6 +31,9 @@ STATE_OUTPUTS = {"D": "jh2_damage", "pressure": "pressure", "eps_p": "plastic_st
                  "strain_rate": "strain_rate"}
 
 
+#: a homogeneous strength (the kernels read an empty factor array as 1)
+NO_FACTOR = np.ones(0)
+
 #: model families: "tl" total-Lagrangian correspondence points (the solids), "ul"
 #: updated-Lagrangian points (the explosive gas, mpipd.model.gas)
 FAMILIES = ("tl", "ul")
@@ -44,6 +47,28 @@ class Material:
 
     def check(self, path):
         positive(self, path, "density", "bulk_modulus", "shear_modulus")
+        h = getattr(self, "heterogeneity", None)
+        if h is not None:
+            have = self.strength_targets
+            for i, t in enumerate(h.applies_to):
+                if t not in have:
+                    fail(join(join(join(path, "heterogeneity"), "applies_to"), i),
+                         f"this material has no strength {t!r} to scale "
+                         f"(it has: {', '.join(have) if have else 'none'})")
+
+    @property
+    def strength_targets(self) -> tuple[str, ...]:
+        """The strengths a heterogeneity field may scale (mpipd.materials.heterogeneity):
+        the tension model's, if there is one."""
+        return ("tension",) if getattr(self, "tension", None) is not None else ()
+
+    def strength_factor(self, state: dict, target: str) -> np.ndarray:
+        """The per-entry factor of a strength ``target`` from the history ``state``
+        (an empty array — factor 1 — where the material is homogeneous in it)."""
+        h = getattr(self, "heterogeneity", None)
+        if h is None or not h.scales(target):
+            return NO_FACTOR
+        return state["strength_factor"]
 
     @property
     def lame_lambda(self) -> float:

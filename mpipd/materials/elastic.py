@@ -16,8 +16,10 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from ..input.schema import tagged
 from . import MATERIALS
 from .base import Material
+from .heterogeneity import DISTRIBUTIONS
 from .tension import TensionFailure
 
 
@@ -45,6 +47,7 @@ class Elastic(Material):
     bulk_modulus: float
     shear_modulus: float
     tension: TensionFailure | None = None
+    heterogeneity: object = tagged(DISTRIBUTIONS, default=None)
 
     dissipative = False
 

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..input.schema import positive
+from ..input.schema import positive, tagged
 from ..kernels.plasticity import deviatoric_rate, radial_return, trial_deviator, von_mises
 from . import MATERIALS
 from .base import Material
+from .heterogeneity import DISTRIBUTIONS
 from .tension import TensionFailure
 
 
@@ -56,6 +57,7 @@ class J2(Material):
     shear_modulus: float = 45e9
     yield_stress: float = 450e6
     tension: TensionFailure | None = None
+    heterogeneity: object = tagged(DISTRIBUTIONS, default=None)
 
     def check(self, path):
         super().check(path)

@@ -45,11 +45,12 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..input.schema import fail, join, non_negative, positive
+from ..input.schema import fail, join, non_negative, positive, tagged
 from ..kernels.layout import MODE_PLASTIC, MODE_TENSILE
 from ..kernels.plasticity import deviatoric_rate, equivalent_rate, radial_return, trial_deviator, von_mises
 from . import MATERIALS
 from .base import Material
+from .heterogeneity import DISTRIBUTIONS
 from .tension import TensionFailure
 
 
@@ -128,14 +129,18 @@ def strength_envelope(ps, rate, A, N, B, M, T_star):
 
 @numba.njit(cache=True)
 def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
-               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T, beta, D1, D2, rate_norm):
+               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
+               t_factor):
     """Advance the unrotated stress of the JH2 points ``idx`` (state arrays are
-    compact: entry k belongs to point idx[k]).  Sets mode[i] on failure."""
-    T_star = T / p_hel
+    compact: entry k belongs to point idx[k]).  Sets mode[i] on failure.
+    ``t_factor``: entry k's factor on T (mpipd.materials.heterogeneity), or empty."""
+    hetero = t_factor.shape[0] > 0
     for k in range(idx.shape[0]):
         i = idx[k]
         if mode[i] != 0:
             continue
+        T = T0 * t_factor[k] if hetero else T0
+        T_star = T / p_hel
         mu = 1.0 / J[i] - 1.0
         p_eos = jh2_pressure(mu, K1, K2, K3)
         p = p_eos + dp[k]
@@ -212,6 +217,7 @@ class JH2(Material):
     D2: float = 0.7
     rate_norm: float = 1.0                # edot_n of Eq. 22 (1/s)
     tension: TensionFailure | None = None
+    heterogeneity: object = tagged(DISTRIBUTIONS, default=None)
 
     def check(self, path):
         super().check(path)
@@ -228,6 +234,10 @@ class JH2(Material):
     def can_fail(self) -> bool:
         return True
 
+    @property
+    def strength_targets(self) -> tuple[str, ...]:
+        return super().strength_targets + ("T",)
+
     def new_state(self, n: int) -> dict:
         return {"D": np.zeros(n), "eps_p": np.zeros(n), "dp": np.zeros(n),
                 "pressure": np.zeros(n), "strain_rate": np.zeros(n)}
@@ -237,7 +247,7 @@ class JH2(Material):
         jh2_update(idx, d, J, dt, sigma, mode, s["D"], s["eps_p"], s["dp"], s["pressure"],
                    s["strain_rate"], self.shear_modulus, self.bulk_modulus, self.K2, self.K3,
                    self.sigma_hel, self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T,
-                   self.beta, self.D1, self.D2, self.rate_norm)
+                   self.beta, self.D1, self.D2, self.rate_norm, self.strength_factor(s, "T"))
 
     def point_strength(self, state: dict, pos: int) -> float:
         """sigma_y = sigma_HEL sigma* (p*, edot*, D) of one point (Eqs. 20–22, the
@@ -245,8 +255,10 @@ class JH2(Material):
         es = state["strain_rate"][pos] / self.rate_norm
         rate = 1.0 + self.C * math.log(es) if es > 1.0 else 1.0
         ps = state["pressure"][pos] / self.p_HEL
+        f = self.strength_factor(state, "T")
+        T = self.T * (f[pos] if len(f) else 1.0)
         return self.sigma_hel * jh2_strength(ps, rate, state["D"][pos], self.A, self.N,
-                                             self.B, self.M, self.T / self.p_HEL)
+                                             self.B, self.M, T / self.p_HEL)
 
     def elastic_energy(self, idx, sigma, J, mode, state, W, out):
         jh2_elastic_energy(idx, sigma, J, mode, self.shear_modulus, self.bulk_modulus,

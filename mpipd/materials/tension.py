@@ -67,16 +67,20 @@ def dynamic_strength(edot, sigma_st, c1, rate0):
 
 
 @numba.njit(cache=True)
-def tension_check(idx, sigma, d, mode, sigma_st, c1, rate0):
-    """Mark mode[i] = 3 and zero the stress of points of ``idx`` that fail. Returns the count."""
+def tension_check(idx, sigma, d, mode, sigma_st, c1, rate0, factor):
+    """Mark mode[i] = 3 and zero the stress of points of ``idx`` that fail. Returns the count.
+    ``factor``: entry k's strength factor (sigma_st -> factor[k] sigma_st,
+    mpipd.materials.heterogeneity); empty for a homogeneous material."""
     n = 0
+    hetero = factor.shape[0] > 0
     for k in range(idx.shape[0]):
         i = idx[k]
         if mode[i] != 0:
             continue
         smax, _ = principal_max_min(sigma[i, 0], sigma[i, 1], sigma[i, 2],
                                     sigma[i, 3], sigma[i, 4], sigma[i, 5])
-        sdt = dynamic_strength(equivalent_strain_rate(d, i), sigma_st, c1, rate0)
+        st = sigma_st * factor[k] if hetero else sigma_st
+        sdt = dynamic_strength(equivalent_strain_rate(d, i), st, c1, rate0)
         if -smax < sdt:
             mode[i] = MODE_TENSION
             for c in range(6):
@@ -100,5 +104,7 @@ class TensionFailure:
         non_negative(self, path, "c1")
         positive(self, path, "rate0")
 
-    def apply(self, idx, sigma, d, mode) -> int:
-        return tension_check(idx, sigma, d, mode, self.sigma_st, self.c1, self.rate0)
+    def apply(self, idx, sigma, d, mode, factor) -> int:
+        """The check of Eqs. 37–38 on the points ``idx`` (``factor``: their strength
+        factors, or an empty array)."""
+        return tension_check(idx, sigma, d, mode, self.sigma_st, self.c1, self.rate0, factor)

@@ -43,11 +43,16 @@ class MaterialGroup:
     """The owned points of one material and that material's history arrays
     (compact: entry k belongs to point idx[k])."""
 
-    def __init__(self, material, idx: np.ndarray, mid: int):
+    def __init__(self, material, idx: np.ndarray, mid: int, gid: np.ndarray):
+        """``gid``: the global ids of the points ``idx`` (a heterogeneous material's
+        strength factors are drawn from them, mpipd.materials.heterogeneity)."""
         self.material = material
         self.mid = mid                          # the material's id (points.material)
         self.idx = idx.astype(np.int64)
         self.state = material.new_state(len(idx))
+        h = getattr(material, "heterogeneity", None)
+        if h is not None:                       # a history array: gathered by class
+            self.state["strength_factor"] = h.factors(gid)
         #: entries of each step class (mpipd.model.multirate); None: all, class 0
         self.by_class = [None]
 
@@ -76,7 +81,10 @@ class MaterialGroup:
 
     def check_tension(self, sigma, d, mode) -> int:
         t = getattr(self.material, "tension", None)
-        return t.apply(self.idx, sigma, d, mode) if t is not None else 0
+        if t is None:
+            return 0
+        return t.apply(self.idx, sigma, d, mode, self.material.strength_factor(self.state,
+                                                                                "tension"))
 
 
 class Correspondence(Model):
@@ -99,7 +107,7 @@ class Correspondence(Model):
         for mid, mat in enumerate(mats):
             idx = np.nonzero(points.material[:n] == mid)[0]
             if len(idx) and mat.family == "tl":
-                self.groups.append(MaterialGroup(mat, idx, mid))
+                self.groups.append(MaterialGroup(mat, idx, mid, points.gid[idx]))
         self.interface = None                   # the ghost-force correction, if any
         # both ends' influence omega(|xi|) of every bond (reference geometry: once)
         self.omega_i = np.empty(len(families.nbr))
@@ -185,6 +193,17 @@ class Correspondence(Model):
                     output=STATE_OUTPUTS.get(key))
         state.offer("stress", own, self.cauchy_stress)
         state.offer("elastic_energy", own, lambda: self.elastic_energy(mode))
+
+    def strength_factors(self) -> np.ndarray | None:
+        """The owned points' strength factors (mpipd.materials.heterogeneity; 1 for a
+        homogeneous material), or None when no material of the scene has one."""
+        if not any(getattr(m, "heterogeneity", None) is not None for m in self.materials):
+            return None
+        out = np.ones(self.points.n_owned)
+        for g in self.groups:
+            if "strength_factor" in g.state:
+                out[g.idx] = g.state["strength_factor"]
+        return out
 
     def attach_interface(self, correction):
         """The ghost-force correction (mpipd.model.interface) becomes the last part

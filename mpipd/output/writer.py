@@ -10,6 +10,9 @@ does not depend on the number of ranks that wrote it::
     /geometry/volume        (N,)
     /geometry/material      (N,)  material id (attrs: names)
     /geometry/part          (N,)  part index (attrs: names)
+    /geometry/strength_factor (N,) a heterogeneous material's strength factor (1
+                            elsewhere; only if some material has one,
+                            mpipd.materials.heterogeneity)
     /fields/<name>          (n_frames, N[, k])   u, v, stress, stress_work, elastic_energy,
                                                  peak_* (running peaks), ...
     /time                   (n_frames,)
@@ -126,6 +129,7 @@ class Writer:
         a["steps"] = n_steps
         a["n_points"] = N
         a["n_bonds"] = sim.n_bonds_global
+        a["joint_bonds"] = sim.joint_bonds          # broken from the start (mpipd.input.joints)
         a["frames_written"] = 0
         g0, g1 = sim.gid_range
         n = sim.points.n_owned
@@ -139,6 +143,8 @@ class Writer:
         dp = geo.create_dataset("part", (N,), "i4")
         dp.attrs["names"] = [q.name for q in scene.parts]
         self._write(dp, np.s_[g0:g1], p.part[:n])
+        for name, values in sim.geometry_fields().items():
+            self._write(geo.create_dataset(name, (N,), "f8"), np.s_[g0:g1], values)
         fg = self.f.create_group("fields")
         self.dsets = {}
         for name in self.fields:
@@ -198,13 +204,18 @@ class Writer:
             self.f.attrs["peak_gas_pressure"] = self.sim.team.max(self.sim.gas.peak_pressure)
         self.f.close()
         if self.sim.team.root:
+            times, geometry = self.time_values()
             write_xdmf(self.path, self.sim.n_global, self.fields, self.frame_no,
-                       self.time_values(), self.n_frames)
+                       times, self.n_frames, geometry)
 
     def time_values(self):
+        """The frames' times and the per-point geometry datasets (name -> "Int" or
+        "Float"), read back by rank 0 for the XDMF file."""
         import h5py
         with h5py.File(self.path, "r") as f:
-            return f["time"][: self.frame_no]
+            geo = {k: ("Int" if d.dtype.kind == "i" else "Float")
+                   for k, d in f["geometry"].items() if d.ndim == 1}
+            return f["time"][: self.frame_no], geo
 
 
 def _xdmf_field_item(h5: str, name: str, k: int, shape, column: int | None = None) -> list:
@@ -248,15 +259,16 @@ def _xdmf_field_item(h5: str, name: str, k: int, shape, column: int | None = Non
             "</DataItem>"]
 
 
-def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | None = None
-               ) -> Path:
+def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | None = None,
+               geometry: dict | None = None) -> Path:
     """An XDMF file next to ``h5path`` describing frames ``0 .. frames-1`` as point clouds.
 
     ``n_alloc`` is the length of the fields' frame axis in the file (the frames the
     run was sized for, default ``frames``): a run stopped early has written fewer.
     Each frame's fields are selections of ``/fields/<name>``, readable by all three
     of ParaView's XDMF readers (see ``_xdmf_field_item``); the HDF5 layout is the
-    one the rest of mpipd reads."""
+    one the rest of mpipd reads.  ``geometry``: the per-point datasets of
+    ``/geometry`` (name -> "Int" or "Float"), each an attribute of every frame."""
     h5 = h5path.name
     out = h5path.with_suffix(".xdmf")
     n_alloc = frames if n_alloc is None else n_alloc
@@ -270,6 +282,11 @@ def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | 
                   '<Geometry GeometryType="XYZ">',
                   f'<DataItem Dimensions="{N} 3" NumberType="Float" Precision="8" '
                   f'Format="HDF">{h5}:/geometry/x</DataItem>', "</Geometry>"]
+        for name, kind in (geometry or {}).items():
+            prec = "4" if kind == "Int" else "8"
+            lines += [f'<Attribute Name="{name}" AttributeType="Scalar" Center="Node">',
+                      f'<DataItem Dimensions="{N}" NumberType="{kind}" Precision="{prec}" '
+                      f'Format="HDF">{h5}:/geometry/{name}</DataItem>', "</Attribute>"]
         for name in fields:
             kk = OUTPUT_FIELDS[name][0]
             # stress: the file's 6 columns, xx yy zz yz xz xy (ParaView names the

@@ -212,5 +212,8 @@ def replicated_parts(scene) -> list[int]:
 
 
 def halo_width(scene) -> float:
-    """Ghost region depth: the largest horizon plus half the largest dx (crossing bonds)."""
-    return scene.max_horizon + 0.5 * scene.max_dx + 1e-9 * scene.max_dx
+    """Ghost region depth: the largest horizon plus half the largest dx (crossing bonds),
+    plus twice the largest jitter offset (a jittered point is up to jitter * dx off its
+    layer's z, mpipd.input.geometry)."""
+    shift = max(q.jitter * q.dx for q in scene.parts)
+    return scene.max_horizon + 0.5 * scene.max_dx + 2.0 * shift + 1e-9 * scene.max_dx
