@@ -48,9 +48,26 @@ def read(run_dir: Path) -> dict:
                "balance": float(f["energy/balance"][-1]),
                "multirate": float(f["energy/multirate"][-1]) if "energy/multirate" in f else 0.0}
     rep = run_dir / "report" / "report.json"
-    out["targets"] = ([(t["label"], t.get("unit", ""), t.get("value"))
-                       for t in json.loads(rep.read_text())["targets"]] if rep.exists() else [])
+    j = json.loads(rep.read_text()) if rep.exists() else {}
+    out["targets"] = [(t["label"], t.get("unit", ""), t.get("value"))
+                      for t in j.get("targets", [])] + lattice_rows(j)
     return out
+
+
+def lattice_rows(report: dict) -> list[tuple[str, str, object]]:
+    """The lattice-bias measure (postprocess.lattice_bias) as target-like rows: a4, a8
+    and the major radial cracks, each the mean over the report's sections."""
+    lb = report.get("lattice_bias")
+    if not isinstance(lb, dict):
+        return []
+    secs = [v for v in lb.values() if isinstance(v, dict) and "a4" in v]
+    if not secs:
+        return []
+    mean = lambda k: float(np.mean([s[k] for s in secs]))      # noqa: E731
+    return [("lattice bias a4, mean over sections", "", mean("a4")),
+            ("lattice bias a8, mean over sections", "", mean("a8")),
+            ("noise level of a4/a8, mean over sections", "", mean("noise")),
+            ("major radial cracks, mean over sections", "", mean("major_radial_cracks"))]
 
 
 def read_report(path: Path) -> dict:
@@ -66,7 +83,8 @@ def read_report(path: Path) -> dict:
             "modes": modes, "broken": int(run["bonds_broken"]),
             "balance": float(j["energy_ledger"]["balance"][-1]),
             "multirate": float(j["energy_ledger"]["final_J"].get("multirate", 0.0)),
-            "targets": [(t["label"], t.get("unit", ""), t.get("value")) for t in j["targets"]]}
+            "targets": [(t["label"], t.get("unit", ""), t.get("value")) for t in j["targets"]]
+            + lattice_rows(j)}
 
 
 def pct(v, ref):
@@ -116,7 +134,9 @@ def quantities(r) -> list[tuple[str, object]]:
     return out
 
 
-def bands(runs: dict, groups: list[str]) -> str:
+def bands(runs: dict, groups: list[str], stats: bool = False) -> str:
+    """Each group's range per quantity (with ``stats``: also mean ± sample standard
+    deviation) and whether the ranges overlap."""
     members = {g: [k for k in runs if k.rpartition("_")[0] == g] for g in groups}
     empty = [g for g, m in members.items() if not m]
     if empty:
@@ -130,11 +150,18 @@ def bands(runs: dict, groups: list[str]) -> str:
         for g in groups:
             vals = [quantities(runs[k])[i][1] for k in members[g]]
             vals = [float(v) for v in vals if isinstance(v, (int, float))]
-            rng.append((min(vals), max(vals)) if vals else None)
+            rng.append((min(vals), max(vals), vals) if vals else None)
         if any(x is None for x in rng):
             continue
-        lo, hi = max(a for a, _ in rng), min(b for _, b in rng)
-        rows.append(f"| {name} | " + " | ".join(f"{a:.4g} – {b:.4g}" for a, b in rng)
+        lo, hi = max(a for a, _, _ in rng), min(b for _, b, _ in rng)
+
+        def cell(a, b, v):
+            if not stats:
+                return f"{a:.4g} – {b:.4g}"
+            if len(v) == 1:
+                return f"{v[0]:.4g}"
+            return f"{np.mean(v):.4g} ± {np.std(v, ddof=1):.2g} ({a:.4g} – {b:.4g})"
+        rows.append(f"| {name} | " + " | ".join(cell(*r) for r in rng)
                     + f" | {'yes' if lo <= hi else 'no'} |")
     return head + "\n".join(rows) + "\n"
 
@@ -145,20 +172,26 @@ def main(argv=None):
     ap.add_argument("--out", required=True)
     ap.add_argument("--bands", help="comma-separated label groups (LABEL = GROUP_SUFFIX): "
                                     "each group's range per quantity")
+    ap.add_argument("--stats", action="store_true",
+                    help="the band table also gives each group's mean ± standard deviation")
+    ap.add_argument("--title", default="", help="a first line for the table's file")
     args = ap.parse_args(argv)
     runs = {}
     for item in args.runs:
         label, _, path = item.partition("=")
         runs[label] = read(Path(path))
-    text = ("Made by `python benchmarks/multirate_compare.py` from the run directories "
+    text = ((args.title + "\n\n" if args.title else "")
+            + "Made by `python benchmarks/multirate_compare.py` from the run directories "
             + ", ".join(f"`{item.partition('=')[2]}`" for item in args.runs)
             + f"; the reference is {list(runs)[0]}.  Run rows from run.h5, then the report's "
             "targets (postprocess report) where the runs have one; in brackets the "
             "difference from the reference.\n\n"
             + table(runs))
     if args.bands:
-        text += ("\nRanges over each group of runs (label before the last `_`), and whether "
-                 "they overlap:\n\n" + bands(runs, args.bands.split(",")))
+        text += ("\nRanges over each group of runs (label before the last `_`)"
+                 + (", mean ± sample standard deviation (range)" if args.stats else "")
+                 + ", and whether the ranges overlap:\n\n"
+                 + bands(runs, args.bands.split(","), args.stats))
     Path(args.out).write_text(text)
     sys.stdout.write(text)
     return 0

@@ -40,3 +40,11 @@ multirate-verify: install
 	for r in $(MR_RUNS); do $(MPIRUN) -n 2 $(PY) -m postprocess report runs/multirate/$$r/run.h5 --out runs/multirate/$$r/report > /dev/null || exit 1; done
 	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4 \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
+
+# the rock mass on blast_demo (README: The rock mass): the lattice, jitter, Weibull
+# strength and both, over 3 seeds, each reported, then docs/rockmass_blast_demo.md
+# (benchmarks/rockmass_study.py; about 25 minutes on 2 cores)
+.PHONY: rockmass-study
+rockmass-study: install
+	$(PY) benchmarks/rockmass_study.py --out runs/rockmass --mpirun "$(MPIRUN)" \
+	    --table docs/rockmass_blast_demo.md

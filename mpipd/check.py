@@ -215,6 +215,9 @@ def check_report(scene, ranks: int) -> str:
                          else "")))
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
+        if p.jitter > 0:
+            out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
+                       f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")
     out.append("  per material (bonds counted from the lattice cross-sections, the model is "
                "not built; the gas's moving families are not counted):")
     for name, mat in scene.materials.items():
@@ -233,6 +236,12 @@ def check_report(scene, ranks: int) -> str:
                 f"dt/dt_c = {dt / dt_c:.2f}; assumed wave speed c_p = {c_p:.1f} m/s, "
                 f"dt holds for waves up to {c_max:.1f} m/s")
         out.append(line)
+        h = getattr(mat, "heterogeneity", None)
+        if h is not None:
+            f = h.inverse_cdf(np.array([0.01, 0.5, 0.99]))
+            out.append(f"      strength: {h.registry_name} factor, mean 1, cv {h.variation():.3f}, "
+                       f"1/50/99 % {f[0]:.3f}/{f[1]:.3f}/{f[2]:.3f}, on "
+                       f"{', '.join(h.applies_to)} (seed {h.seed})")
         mu = wave_speed_limit(mat, c_max)
         if mu is not None:
             c_far = float(mat.p_wave_speed_at(MU_FAR))
@@ -248,6 +257,14 @@ def check_report(scene, ranks: int) -> str:
                        f"K3 = {mat.K3:.4g} Pa): the wave speed and the viscosity use K1 there")
     out.append(f"  total: {table.n_points} points, {int(bonds.sum())} bonds "
                f"(counted from the cross-sections)")
+    for i, jt in enumerate(scene.joints):
+        kind = ("a set, spacing " + f"{jt.spacing:g} m" if jt.spacing > 0 else "one joint")
+        out.append(f"  joint {i}: {kind} through {list(jt.point)}, normal {list(jt.normal)}, "
+                   + (f"discs of radius {jt.radius:g} m" if jt.radius > 0 else "unbounded")
+                   + f", persistence {jt.persistence:g}"
+                   + (f" in {jt.patch:g} m patches (seed {jt.seed})" if jt.persistence < 1 else "")
+                   + f"; cuts {', '.join(jt.parts) if jt.parts else 'every solid part'}: "
+                   "its crossing bonds start broken (the run log counts them)")
     dt_max = critical_dt(scene)
     if scene.time.multirate is not None and scene.time.multirate.max_ratio > 1:
         out.extend(class_report(scene, table, bonds, part_dt))

@@ -149,7 +149,7 @@ def test_rockmass_identical_on_1_2_3_ranks(rockmass_runs, fracture_runs):
         assert f.attrs["joint_bonds"] == 0
     assert broken > 1000 and joint > 1000
     assert ref["fields/damage"][0].max() > 0.2             # the joints show at t = 0
-    assert 0.17 < ref["geometry/strength_factor"].std() < 0.22     # m = 6: cv 0.188
+    assert 0.17 < ref["geometry/strength_factor"].std() < 0.22     # m = 6: cv 0.194
     for n in (2, 3):
         with h5py.File(rockmass_runs[n], "r") as f:
             assert f.attrs["bonds_broken"] == broken and f.attrs["joint_bonds"] == joint

@@ -16,7 +16,7 @@ The draw is u = hashrng.uniform(seed, STREAM_STRENGTH, gid) and f = F^-1(u): a
 function of the point's global id and the seed only, so the field is the same
 on any rank count and after any restart.  Distributions (registry below):
 
-* weibull (``modulus`` m > 0): f = lambda (-ln u)^(1/m), lambda = 1 / Gamma(1 + 1/m)
+* weibull (``modulus`` m > 0): f = lambda (-ln(1 - u))^(1/m), lambda = 1 / Gamma(1 + 1/m)
   (mean 1; coefficient of variation sqrt(Gamma(1 + 2/m) / Gamma(1 + 1/m)^2 - 1));
 * uniform (``width`` w in [0, 1)): f = 1 + w (2u - 1), on [1 - w, 1 + w];
 * normal (``cv``, ``truncate`` t = 3): f = 1 + cv z, z standard normal truncated
@@ -103,7 +103,7 @@ class Weibull(Distribution):
         return 1.0 / float(gamma(1.0 + 1.0 / self.modulus))
 
     def inverse_cdf(self, u):
-        return self.scale * (-np.log(u)) ** (1.0 / self.modulus)
+        return self.scale * (-np.log1p(-u)) ** (1.0 / self.modulus)
 
     def variation(self) -> float:
         m = self.modulus
