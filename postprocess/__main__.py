@@ -177,9 +177,20 @@ def main(argv=None) -> int:
                     "verbatim under 'Diagnoses'")
     va.add_argument("--check", action="store_true",
                     help="only check that every input exists (exit 2 naming what is missing)")
+    fg = sub.add_parser("fragments", help="fragments of a frame and the size distribution")
+    fg.add_argument("run")
+    fg.add_argument("--out", default=None, help="directory (default: RUN's folder /fragments)")
+    fg.add_argument("--frame", type=int, default=-1, help="frame index (default: the last)")
+    fg.add_argument("--parts", default=None,
+                    help="comma-separated parts to analyse (default: the rock, jh2 parts)")
+    fg.add_argument("--min-points", type=int, default=8,
+                    help="smaller components are fines (default 8 = 2 x 2 x 2 points)")
+    fg.add_argument("--damage-threshold", type=float, default=None,
+                    help="also cut bonds whose two ends both have damage above this")
+    fg.add_argument("--z", type=float, default=None, help="height of the section figure (m)")
     args = ap.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
-    if args.cmd in ("report", "compare", "validate"):
+    if args.cmd in ("report", "compare", "validate", "fragments"):
         return _guarded(comm, _analysis_cmd, args, comm)
     try:
         run = Run(args.run, comm)
@@ -215,6 +226,14 @@ def main(argv=None) -> int:
 
 def _analysis_cmd(args, comm) -> list[str]:
     from pathlib import Path
+    if args.cmd == "fragments":
+        from .fragment_report import make_fragments
+        if args.min_points < 1:
+            raise UsageError(f"--min-points must be >= 1 (got {args.min_points})")
+        out = args.out or str(Path(args.run).resolve().parent / "fragments")
+        parts = args.parts.split(",") if args.parts else None
+        return make_fragments(args.run, out, comm, args.frame, parts, args.min_points,
+                              args.damage_threshold, args.z)
     if args.cmd == "report":
         from .report import make_report
         out = args.out or str(Path(args.run).resolve().parent / "report")

@@ -38,6 +38,19 @@ class Families:
     def n_bonds(self) -> int:
         return len(self.nbr)
 
+    def broken_pairs(self, gid: np.ndarray, lower: bool = False) -> np.ndarray:
+        """(gid_i, gid_j) of the broken bonds of the owned points' families, in family
+        order (gid_i ascending, then gid_j): every directed copy, or with ``lower``
+        only those with gid_i < gid_j — each bond once over all ranks, since the
+        owner of its lower-gid end holds that copy."""
+        rows = np.repeat(np.arange(len(self.offsets) - 1), np.diff(self.offsets))
+        b = self.broken.astype(bool)
+        gi, gj = gid[rows[b]], gid[self.nbr[b]]
+        if lower:
+            keep = gi < gj
+            gi, gj = gi[keep], gj[keep]
+        return np.stack([gi, gj], axis=1).astype(np.int64)
+
     def register(self, state):
         """The CSR arrays in the State (owner "families"; ``broken`` is written by
         Failure, and saved in checkpoints as gid pairs, not as a field)."""

@@ -46,13 +46,6 @@ def _per_point(sim) -> dict:
     return {f.name: f.owned_values(n) for f in sim.state.checkpointed()}
 
 
-def _broken_pairs(sim) -> np.ndarray:
-    fam, gid = sim.families, sim.points.gid
-    rows = np.repeat(np.arange(sim.points.n_owned), np.diff(fam.offsets))
-    b = fam.broken.astype(bool)
-    return np.stack([gid[rows[b]], gid[fam.nbr[b]]], axis=1).astype(np.int64)
-
-
 def write(sim, path, scene_text: str, overrides=(), run_id: str = "") -> Path:
     """Write the checkpoint of run ``run_id`` to ``path`` (collective).  If writing
     fails (a full disk), the partial ``<path>.tmp`` is removed and the error raised;
@@ -80,7 +73,7 @@ def _write(sim, tmp, scene_text, overrides, run_id):
     team = sim.team
     N = sim.n_global
     g0, g1 = sim.gid_range
-    pairs = _broken_pairs(sim)
+    pairs = sim.families.broken_pairs(sim.points.gid)
     counts = team.gather(len(pairs))
     p0 = int(sum(counts[:team.rank]))
     total = int(sum(counts))

@@ -18,6 +18,11 @@ does not depend on the number of ranks that wrote it::
     /time                   (n_frames,)
     /energy/<term>          (n_frames,)  the energy ledger (mpipd.model.ledger.TERMS)
     /probes/<name>/{t, sigma_rr, v_r, p, s, strength}          (n_steps + 1,), row = step
+    /bonds/broken           (M, 2) int64: the broken bonds of every frame as (gid_lo,
+                            gid_hi) pairs, gid_lo < gid_hi, each bond once; frame k's
+                            set is rows offsets[k]:offsets[k + 1] (sorted by gid_lo);
+                            only in a scene that can fail or has joints
+    /bonds/offsets          (n_frames + 1,) int64
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
 
@@ -107,10 +112,16 @@ class Writer:
             self.time = self.f["time"]
             self.energy = {k: self.f["energy"][k] for k in self.f["energy"]}
             self.frame_no = sim.step_count // self.every + 1
+            self.bonds = self.f["bonds"] if "bonds" in self.f else None
             if self.time.shape[0] != self.n_frames:          # a new run length
                 for d in (*self.dsets.values(), self.time, *self.energy.values()):
                     d.resize(self.n_frames, axis=0)
+                if self.bonds is not None:
+                    self.bonds["offsets"].resize(self.n_frames + 1, axis=0)
                 self.f.attrs["steps"] = n_steps
+            if self.bonds is not None:       # frames after the checkpoint are written again
+                self.bond_rows = int(self.bonds["offsets"][self.frame_no])
+                self.bonds["broken"].resize(self.bond_rows, axis=0)
             if sim.probes is not None:
                 sim.probes.create(self.f, n_steps + 1)
             return
@@ -160,6 +171,15 @@ class Writer:
                            "(initial + external - held - dissipated) / scale")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8",
                                             **growable((self.n_frames,))) for k in TERMS}
+        self.bonds, self.bond_rows = None, 0
+        if sim.failure is not None or sim.joint_bonds:
+            self.bonds = self.f.create_group("bonds")
+            self.bonds.create_dataset("broken", (0, 2), "i8", maxshape=(None, 2),
+                                      chunks=(65536, 2))
+            off = self.bonds.create_dataset("offsets", (self.n_frames + 1,), "i8",
+                                            **{**growable((self.n_frames + 1,)),
+                                               "fillvalue": -1})       # -1: not written
+            self._write(off, np.s_[0:1], np.zeros(1, np.int64))
         if sim.probes is not None:
             sim.probes.create(self.f, n_steps + 1)
 
@@ -180,11 +200,27 @@ class Writer:
         self._write(self.time, np.s_[k:k + 1], np.array([sim.t]))
         for key, d in self.energy.items():
             self._write(d, np.s_[k:k + 1], np.array([values[key]]))
+        if self.bonds is not None:
+            self._broken_bonds(sim, k)
         self.frame_no += 1
         if sim.probes is not None:
             sim.probes.flush()
         self.f.attrs["frames_written"] = self.frame_no
         self.f.flush()                  # a crash loses at most the frames since this one
+
+    def _broken_bonds(self, sim, k: int):
+        """Append frame k's broken bonds to /bonds/broken (each rank its owned
+        points' lower-gid copies, in rank = gid order: the rows come out sorted)."""
+        pairs = sim.families.broken_pairs(sim.points.gid, lower=True)
+        counts = sim.team.gather(len(pairs))
+        start = self.bond_rows + int(sum(counts[:sim.team.rank]))
+        self.bond_rows += int(sum(counts))
+        d = self.bonds["broken"]
+        d.resize(self.bond_rows, axis=0)                 # collective
+        # independent I/O: a collective write hangs when one rank has nothing to write
+        if len(pairs):
+            d[start:start + len(pairs)] = pairs
+        self._write(self.bonds["offsets"], np.s_[k + 1:k + 2], np.array([self.bond_rows]))
 
     def close(self, segment: dict | None = None):
         """Finish the file.  ``segment`` (this invocation's first and last step, ranks,
