@@ -48,6 +48,8 @@ def main(argv=None):
     ap.add_argument("--out", default="runs/rockmass")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     ap.add_argument("--mpirun", default="mpirun")
+    ap.add_argument("--ranks", type=int, default=2,
+                    help="ranks per run (the results do not depend on it)")
     ap.add_argument("--table", default="docs/rockmass_blast_demo.md")
     ap.add_argument("--reuse", action="store_true",
                     help="keep runs whose report exists (resume a study)")
@@ -59,11 +61,13 @@ def main(argv=None):
         if args.reuse and (d / "report" / "report.json").exists():
             continue
         sets = [a for o in over for a in ("--set", o)]
-        cmd = [*shlex.split(args.mpirun), "-n", "2", str(BIN / "mpipd"), "run", scene, "--out", str(d),
+        cmd = [*shlex.split(args.mpirun), "-n", str(args.ranks), str(BIN / "mpipd"), "run", scene,
+               "--out", str(d),
                "--overwrite", "--quiet", *sets]
         print(" ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
-        subprocess.run([*shlex.split(args.mpirun), "-n", "2", sys.executable, "-m", "postprocess", "report",
+        subprocess.run([*shlex.split(args.mpirun), "-n", str(args.ranks), sys.executable, "-m",
+                        "postprocess", "report",
                         str(d / "run.h5"), "--out", str(d / "report")], check=True,
                        stdout=subprocess.DEVNULL)
     title = ("# The rock mass on blast_demo: lattice, jitter, Weibull strength, both "
