@@ -54,15 +54,40 @@ def _sorted_yx(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return x[order], y[order]
 
 
+@dataclass(frozen=True)
+class Hole:
+    """A hole along z through a box: ``center`` (x, y) and ``radius`` (m)."""
+    center: tuple[float, float]
+    radius: float
+
+    def check(self, path):
+        positive(self, path, "radius")
+
+
 @SHAPES.register("box")
 @dataclass(frozen=True)
 class Box:
-    """Axis-aligned box ``lo``..``hi`` (m)."""
+    """Axis-aligned box ``lo``..``hi`` (m), optionally with ``holes`` along z through
+    it (boreholes: a lattice point is kept where r >= radius from every hole's
+    centre, the annulus's rule for its inner radius)."""
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
+    holes: tuple[Hole, ...] = ()
 
     def check(self, path):
         ordered_box(self, path, strict=True)
+        for i, h in enumerate(self.holes):
+            c, r = h.center, h.radius
+            if not (self.lo[0] < c[0] - r and c[0] + r < self.hi[0]
+                    and self.lo[1] < c[1] - r and c[1] + r < self.hi[1]):
+                fail(join(join(path, "holes"), i), "a hole must lie inside the box's x-y "
+                                                   "section (a free face needs rock in front)")
+
+    def _outside_holes(self, x, y, margin):
+        keep = np.ones(np.shape(x), bool)
+        for h in self.holes:
+            keep &= np.hypot(x - h.center[0], y - h.center[1]) > h.radius + margin
+        return keep
 
     def z_levels(self, dx):
         return _cells(self.lo[2], self.hi[2], dx)
@@ -73,17 +98,23 @@ class Box:
 
     @property
     def area(self):
-        return (self.hi[0] - self.lo[0]) * (self.hi[1] - self.lo[1])
+        return ((self.hi[0] - self.lo[0]) * (self.hi[1] - self.lo[1])
+                - sum(np.pi * h.radius ** 2 for h in self.holes))
 
     def contains_xy(self, x, y, margin):
         return ((x > self.lo[0] + margin) & (x < self.hi[0] - margin)
-                & (y > self.lo[1] + margin) & (y < self.hi[1] - margin))
+                & (y > self.lo[1] + margin) & (y < self.hi[1] - margin)
+                & self._outside_holes(x, y, margin))
 
     def cross_section(self, dx):
         xs = _cells(self.lo[0], self.hi[0], dx)
         ys = _cells(self.lo[1], self.hi[1], dx)
         X, Y = np.meshgrid(xs, ys, indexing="xy")    # rows = y, so ravel is (y, x) order
-        return X.ravel(), Y.ravel()
+        X, Y = X.ravel(), Y.ravel()
+        keep = np.ones(len(X), bool)
+        for h in self.holes:
+            keep &= (X - h.center[0]) ** 2 + (Y - h.center[1]) ** 2 >= h.radius ** 2
+        return X[keep], Y[keep]
 
 
 @SHAPES.register("cylinder")

@@ -157,6 +157,23 @@ class Band:
 
 
 @dataclass(frozen=True)
+class Initiation:
+    """When and where a charge (a part of the explosive) is lit: the face z = ``z`` at
+    ``time`` (s), the detonation running along +z (``direction`` 1) or -z (-1): a
+    point at reference height z' is lit at time + (z' - z) direction / vod
+    (mpipd.model.gas).  A charge without one follows its material's initiation_z
+    and direction at time 0."""
+    z: float = 0.0
+    time: float = 0.0
+    direction: float = 1.0
+
+    def check(self, path):
+        non_negative(self, path, "time")
+        if self.direction not in (1.0, -1.0):
+            fail(join(path, "direction"), "must be 1 or -1")
+
+
+@dataclass(frozen=True)
 class Part:
     name: str
     material: str
@@ -168,6 +185,7 @@ class Part:
     influence: str = "quadratic"
     jitter: float = 0.0               # lattice jitter, fraction of dx (mpipd.input.geometry)
     jitter_seed: int = 1
+    initiation: Initiation | None = None    # a charge's own initiation (explosive parts)
 
     def check(self, path):
         positive(self, path, "dx")
@@ -321,6 +339,10 @@ class Scene:
                                               "uses the quadratic influence function")
             names.add(p.name)
         gas = self.gas_materials
+        for i, p in enumerate(self.parts):
+            if p.initiation is not None and p.material not in gas:
+                fail(f"parts[{i}].initiation", f"only a charge (a part of an explosive, jwl, "
+                                               f"material) is initiated; {p.material!r} is not")
         if len(gas) > 1:
             fail("materials", f"one explosive (jwl) material at most (got {', '.join(gas)})")
         for m in gas:

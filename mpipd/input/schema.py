@@ -90,6 +90,9 @@ def _coerce(tp, value, path):
     if origin in (typing.Union, types.UnionType):
         if value is None and type(None) in args:
             return None
+        options = [a for a in args if a is not type(None)]
+        if len(options) == 1:               # X | None: X's own error, with its own key path
+            return _coerce(options[0], value, path)
         errors = []
         for a in args:
             if a is type(None):

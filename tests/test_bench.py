@@ -1,0 +1,57 @@
+"""Several charges with their own initiation, and a box with boreholes (issue 19)."""
+import numpy as np
+import pytest
+from conftest import run_cli
+from test_scene_errors import check_bad
+
+from mpipd.input import scene as sc
+from mpipd.model.gas import lighting_times
+
+VOD = 6690.0
+
+
+def test_each_charge_is_lit_on_its_own_schedule():
+    scene, _ = sc.load("blast_bench:long")
+    charges = [k for k, q in enumerate(scene.parts) if q.material == "explosive"]
+    assert len(charges) == 3
+    z = np.array([0.0, 0.003, 0.006] * 3)
+    part = np.repeat(charges, 3)
+    t = lighting_times(scene, part, z, scene.materials["explosive"])
+    for j, delay in enumerate((0.0, 8e-6, 16e-6)):    # the case's delays, + z / vod
+        np.testing.assert_allclose(t[3 * j:3 * j + 3], delay + np.array([0, 0.003, 0.006]) / VOD,
+                                   rtol=0, atol=1e-18)
+
+
+def test_a_charge_without_its_own_initiation_follows_the_material():
+    scene, _ = sc.load("blast_demo", ["materials.explosive.initiation_z=0.006",
+                                      "materials.explosive.direction=-1.0"])
+    t = lighting_times(scene, np.zeros(2, int), np.array([0.006, 0.0]),
+                       scene.materials["explosive"])
+    np.testing.assert_allclose(t, [0.0, 0.006 / VOD])
+
+
+def test_box_holes_are_empty_and_the_tubes_fit_them():
+    scene, _ = sc.load("blast_bench")
+    rock = next(q for q in scene.parts if q.name == "rock")
+    x, y = rock.shape.cross_section(rock.dx)
+    for h in rock.shape.holes:
+        r2 = (x - h.center[0]) ** 2 + (y - h.center[1]) ** 2
+        assert r2.min() >= h.radius ** 2
+        assert r2.min() < (h.radius + rock.dx) ** 2          # the wall is the next lattice ring
+    full = (80 * 50)                                          # 1 mm cells of the 80 x 50 mm box
+    holes = full - len(x)
+    assert 3 * 28 <= holes <= 3 * 40                         # ~ pi 3.2^2 = 32 cells a hole
+    assert rock.shape.area == pytest.approx(0.08 * 0.05 - 3 * np.pi * 0.0032 ** 2)
+
+
+def test_bad_initiation_and_holes(tmp_path):
+    out = tmp_path / "out"
+    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
+                       "parts.6.initiation={time=1e-6}"]), out, "parts[6].initiation",
+              "only a charge")
+    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
+                       "parts.0.initiation.time=-1e-6"]), out, "parts[0].initiation.time",
+              "must be >= 0")
+    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
+                       "parts.6.shape.holes.0.center=[0.039, 0.015]"]), out,
+              "parts[6].shape.holes[0]", "inside the box")
