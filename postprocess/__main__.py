@@ -188,9 +188,13 @@ def main(argv=None) -> int:
     fg.add_argument("--damage-threshold", type=float, default=None,
                     help="also cut bonds whose two ends both have damage above this")
     fg.add_argument("--z", type=float, default=None, help="height of the section figure (m)")
+    bn = sub.add_parser("bench", help="fragmentation, overbreak and PPV of bench blasts")
+    bn.add_argument("runs", nargs="+")
+    bn.add_argument("--out", default="bench", help="directory (default: ./bench)")
+    bn.add_argument("--labels", default=None, help="comma-separated run labels")
     args = ap.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
-    if args.cmd in ("report", "compare", "validate", "fragments"):
+    if args.cmd in ("report", "compare", "validate", "fragments", "bench"):
         return _guarded(comm, _analysis_cmd, args, comm)
     try:
         run = Run(args.run, comm)
@@ -226,6 +230,13 @@ def main(argv=None) -> int:
 
 def _analysis_cmd(args, comm) -> list[str]:
     from pathlib import Path
+    if args.cmd == "bench":
+        from .bench import make_bench
+        labels = args.labels.split(",") if args.labels else [Path(r).parent.name
+                                                              for r in args.runs]
+        if len(labels) != len(args.runs) or len(set(labels)) != len(labels):
+            raise UsageError("--labels: one distinct label per run")
+        return make_bench(args.runs, labels, args.out, comm)
     if args.cmd == "fragments":
         from .fragment_report import make_fragments
         if args.min_points < 1:

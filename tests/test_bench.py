@@ -55,3 +55,48 @@ def test_bad_initiation_and_holes(tmp_path):
     check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
                        "parts.6.shape.holes.0.center=[0.039, 0.015]"]), out,
               "parts[6].shape.holes[0]", "inside the box")
+
+
+@pytest.fixture(scope="module")
+def first_microsecond(tmp_path_factory):
+    """blast_bench, simultaneous and with the long delays, to 0.6 us (30 steps)."""
+    d = tmp_path_factory.mktemp("bench")
+    out = {}
+    for case in ("simultaneous", "long"):
+        res = run_cli(["run", f"blast_bench:{case}", "--out", str(d / case), "--quiet",
+                       "--set", "time.t_end=6e-7", "--set", "output.every=30"], timeout=600)
+        assert res.returncode == 0, res.stdout + res.stderr
+        out[case] = d / case / "run.h5"
+    return d, out
+
+
+def test_only_the_lit_charges_push(first_microsecond):
+    import h5py
+    _, runs = first_microsecond
+    for case, lit in (("simultaneous", [True, True, True]), ("long", [True, False, False])):
+        with h5py.File(runs[case], "r") as f:
+            part = f["geometry/part"][...]
+            names = list(f["geometry/part"].attrs["names"])
+            p = f["fields/pressure"][-1]
+            for k, on in enumerate(lit):
+                gas = p[part == names.index(f"charge{k + 1}")]
+                assert (gas.max() > 1e9) == on, (case, k, gas.max())
+
+
+def test_bench_summary_side_by_side(first_microsecond, tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from conftest import child_env
+    _, runs = first_microsecond
+    res = subprocess.run([sys.executable, "-m", "postprocess", "bench", str(runs["simultaneous"]),
+                          str(runs["long"]), "--labels", "sim,long", "--out", str(tmp_path / "b")],
+                         capture_output=True, text=True, timeout=300, env=child_env())
+    assert res.returncode == 0, res.stdout + res.stderr
+    doc = json.loads((tmp_path / "b" / "bench.json").read_text())
+    assert doc["sim"]["burden_mm"] == pytest.approx(15.0)
+    # at 0.6 us the three lit holes have moved the rock behind the row more than one
+    assert max(doc["sim"]["ppv_m_s"]) > max(doc["long"]["ppv_m_s"]) > 0
+    assert (tmp_path / "b" / "sim" / "fragments.csv").exists()
+    assert "| overbreak behind the row (mm) |" in (tmp_path / "b" / "bench.md").read_text()
