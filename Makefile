@@ -36,6 +36,7 @@ test: install paraview
 
 bench: install
 	$(PY) benchmarks/run.py
+	$(PY) benchmarks/fragments_bench.py
 
 # ruff (lint + import order), configured in pyproject.toml; tests/test_lint.py runs it too
 lint: install
