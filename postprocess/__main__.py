@@ -93,12 +93,12 @@ def section(run: Run, comm, field: str, frame: int, z: float | None):
     zmin = run.min(x[:, 2].min() if len(x) else np.inf)
     zmax = run.max(x[:, 2].max() if len(x) else -np.inf)
     target = 0.5 * (zmin + zmax) if z is None else z
-    levels = np.unique(x[:, 2])
+    levels = np.unique(run.z_level)
     near = levels[np.argmin(np.abs(levels - target))] if len(levels) else np.inf
     dist = run.min(abs(near - target))
     cands = comm.allgather(near if abs(near - target) == dist else np.inf)
     zlev = min(cands)
-    sel = x[:, 2] == zlev
+    sel = run.z_level == zlev
     vals = run.field(field, frame)[sel]
     if vals.ndim > 1:
         raise ValueError(f"field {field!r} is not a scalar")

@@ -84,7 +84,7 @@ class Run:
         r, n, N = self.comm.Get_rank(), self.comm.Get_size(), self.n_points
         lo0, hi0 = N * r // n, N * (r + 1) // n
         a = max(lo0 - 1, 0)
-        z = self.f["geometry/x"][a:hi0, 2]
+        z = self._z_level(a, hi0)
         starts = np.flatnonzero(np.diff(z) != 0) + 1 + a     # gids where a new level begins
         first = int(starts[starts >= lo0][0]) if np.any(starts >= lo0) else N
         if lo0 == 0:
@@ -93,11 +93,25 @@ class Run:
         self.lo = min(firsts[r:]) if r else 0
         self.hi = min(firsts[r + 1:] + [N])
         self.hi = max(self.hi, self.lo)
-        zl = self.f["geometry/x"][self.lo:self.hi, 2]
+        zl = self._z_level(self.lo, self.hi)
         self.levels = (np.concatenate(([0], np.flatnonzero(np.diff(zl) != 0) + 1))
                        if len(zl) else np.zeros(0, dtype=np.int64))
         self.level_z = zl[self.levels] if len(zl) else np.zeros(0)
         self.n_levels = self.sum_int(len(self.levels))
+
+    def _z_level(self, a: int, b: int) -> np.ndarray:
+        """The z of the lattice level of points a:b: ``/geometry/z_level`` where the
+        lattice is jittered (mpipd.input.geometry), else the points' own z."""
+        g = self.f["geometry"]
+        return g["z_level"][a:b] if "z_level" in g else g["x"][a:b, 2]
+
+    @property
+    def z_level(self) -> np.ndarray:
+        """This rank's points' lattice level z (their z on an unjittered lattice):
+        a section at a level is the points whose z_level equals it."""
+        if "z_level" not in self._geo:
+            self._geo["z_level"] = self._z_level(self.lo, self.hi)
+        return self._geo["z_level"]
 
     # ------------------------------------------------------------------ reads
     def geometry(self, name: str) -> np.ndarray:

@@ -53,7 +53,7 @@ def gather_sections(run, model, zlevels, requests) -> dict | None:
     pid = run.geometry("part")
     local = {}
     for z in zlevels:
-        idx = np.flatnonzero((pid == model.rock) & (x[:, 2] == z))
+        idx = np.flatnonzero((pid == model.rock) & (run.z_level == z))
         if not len(idx):
             continue
         a, b = int(idx[0]), int(idx[-1]) + 1

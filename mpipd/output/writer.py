@@ -10,6 +10,8 @@ does not depend on the number of ranks that wrote it::
     /geometry/volume        (N,)
     /geometry/material      (N,)  material id (attrs: names)
     /geometry/part          (N,)  part index (attrs: names)
+    /geometry/z_level       (N,)  the z of each point's lattice level (only when a part
+                            is jittered: the points are off their levels)
     /geometry/strength_factor (N,) a heterogeneous material's strength factor (1
                             elsewhere; only if some material has one,
                             mpipd.materials.heterogeneity)
@@ -154,6 +156,10 @@ class Writer:
         dp = geo.create_dataset("part", (N,), "i4")
         dp.attrs["names"] = [q.name for q in scene.parts]
         self._write(dp, np.s_[g0:g1], p.part[:n])
+        if any(q.jitter > 0 for q in scene.parts):     # the lattice levels (postprocess)
+            t, (a0, b0) = sim.slabs.table, sim.slabs.owned(sim.team.rank)
+            self._write(geo.create_dataset("z_level", (N,), "f8"), np.s_[g0:g1],
+                        np.repeat(t.z[a0:b0], t.count[a0:b0]))
         for name, values in sim.geometry_fields().items():
             self._write(geo.create_dataset(name, (N,), "f8"), np.s_[g0:g1], values)
         fg = self.f.create_group("fields")
