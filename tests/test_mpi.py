@@ -150,6 +150,17 @@ def test_rockmass_identical_on_1_2_3_ranks(rockmass_runs, fracture_runs):
     assert broken > 1000 and joint > 1000
     assert ref["fields/damage"][0].max() > 0.2             # the joints show at t = 0
     assert 0.17 < ref["geometry/strength_factor"].std() < 0.22     # m = 6: cv 0.194
+    # the postprocess reader cuts the jittered points by their lattice levels
+    from mpi4py import MPI
+
+    from postprocess.reader import Run
+    run = Run(rockmass_runs[1], MPI.COMM_SELF)
+    try:
+        np.testing.assert_allclose(np.unique(run.z_level), (np.arange(6) + 0.5) * 1e-3,
+                                   rtol=0, atol=1e-15)
+        assert run.n_levels == 6 and len(np.unique(run.geometry("x")[:, 2])) > 1000
+    finally:
+        run.close()
     for n in (2, 3):
         with h5py.File(rockmass_runs[n], "r") as f:
             assert f.attrs["bonds_broken"] == broken and f.attrs["joint_bonds"] == joint
