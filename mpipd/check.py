@@ -215,6 +215,15 @@ def check_report(scene, ranks: int) -> str:
                          else "")))
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
+        if is_gas_part(scene, p):
+            ini = p.initiation
+            z0, d0, t0 = ((ini.z, ini.direction, ini.time) if ini is not None
+                          else (mat.initiation_z, mat.direction, 0.0))
+            zs = p.shape.z_range
+            t_last = t0 + max((zs[1] - z0) * d0, (zs[0] - z0) * d0) / mat.vod
+            out.append(f"    initiation: from z = {z0:g} m at t = {t0 * 1e6:.4g} us "
+                       f"({'+' if d0 > 0 else '-'}z), the charge lit by {t_last * 1e6:.4g} us"
+                       + ("" if ini is not None else " (the material's)"))
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")
