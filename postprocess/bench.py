@@ -162,7 +162,7 @@ def _pct(v):
 
 
 def _curves_png(out, labels):
-    from .plotting import plain_log, pyplot, save
+    from .plotting import log_axes, pyplot, save
     from .sieve import passing
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.2, 3.6))
@@ -173,17 +173,12 @@ def _curves_png(out, labels):
         if big.sum():
             x, P = passing(rows["sieve_m"][big], rows["mass_kg"][big])
             ax.step(x * 1e3, 100 * P, where="post", label=label)
-    ax.set_xscale("log")
-    ax.set_xlabel("sieve size (mm)")
-    ax.set_ylabel("mass passing (%)")
-    ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
-    plain_log(ax)
+    log_axes(ax, "sieve size (mm)", "mass passing (%)")
     return save(fig, out / "bench_passing.png")
 
 
 def _ppv_png(out, rows):
-    from .plotting import plain_log, pyplot, save
+    from .plotting import log_axes, pyplot, save
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.2, 3.6))
     for label, r in rows.items():
@@ -194,11 +189,5 @@ def _ppv_png(out, rows):
         if f:
             dd = np.geomspace(*f["d_range_mm"], 50)
             ax.plot(dd, f["K"] * (dd * 1e-3) ** -f["beta"], "-", lw=0.8, color=line.get_color())
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("distance behind the row (mm)")
-    ax.set_ylabel("PPV (m/s)")
-    ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
-    plain_log(ax)
+    log_axes(ax, "distance behind the row (mm)", "PPV (m/s)", logy=True)
     return save(fig, out / "bench_ppv.png")

@@ -177,7 +177,7 @@ def _write(out: Path, stats: dict, section, meta: dict) -> list[str]:
 
 
 def _curve_png(path, x, P, s, doc):
-    from .plotting import plain_log, pyplot, save
+    from .plotting import log_axes, pyplot, save
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.2, 3.6))
     ax.step(x * 1e3, 100 * P, where="post", color="k", lw=1.2, label="fragments")
@@ -189,14 +189,9 @@ def _curve_png(path, x, P, s, doc):
     if sw:
         ax.plot(xs * 1e3, 100 * swebrec(xs, sw["x50"], sw["xmax"], sw["b"]), ":",
                 label=f"Swebrec b={sw['b']:.2f}")
-    ax.set_xscale("log")
-    ax.set_xlabel("sieve size (mm)")
-    ax.set_ylabel("mass passing (%)")
     ax.set_title(f"{doc['fragments']} fragments, t = {doc['t_us']:.3g} us; "
                  f"X50 {s['x50'] * 1e3:.3g} mm, X80 {s['x80'] * 1e3:.3g} mm")
-    ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
-    plain_log(ax)
+    log_axes(ax, "sieve size (mm)", "mass passing (%)")
     return save(fig, path)
 
 

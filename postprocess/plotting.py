@@ -41,3 +41,15 @@ def plain_log(ax):
             axis.set_major_formatter(fmt)
             axis.set_minor_formatter(FuncFormatter(
                 lambda v, _: f"{v:g}" if str(f"{v:g}")[0] in "25" else ""))
+
+
+def log_axes(ax, xlabel: str, ylabel: str, logy: bool = False):
+    """A log x (and optionally log y) axis with plain tick numbers, a grid and a legend."""
+    ax.set_xscale("log")
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=7)
+    plain_log(ax)
