@@ -202,9 +202,10 @@ def _section_png(path, section, stats, big):
     fig, ax = plt.subplots(figsize=(4.6, 4.4))
     fine = set(stats["label"][~big].tolist())
     is_fine = np.fromiter((v in fine for v in lab), bool, len(lab))
-    ax.scatter(xs[is_fine] * 1e3, ys[is_fine] * 1e3, s=1, c="0.8", lw=0)
+    ax.scatter(xs[is_fine] * 1e3, ys[is_fine] * 1e3, s=4, c="0.6", lw=0)
     rng = (lab[~is_fine] * 2654435761) % 4096 / 4096.0      # a colour per label
-    ax.scatter(xs[~is_fine] * 1e3, ys[~is_fine] * 1e3, s=2, c=rng, cmap="tab20", lw=0)
+    ax.scatter(xs[~is_fine] * 1e3, ys[~is_fine] * 1e3, s=6, c=rng, cmap="tab20", vmin=0, vmax=1,
+               lw=0)
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
