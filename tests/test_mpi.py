@@ -73,7 +73,11 @@ def test_output_layout_and_xdmf(runs):
     assert len(grids) == 4
     names = {a.get("Name") for a in grids[-1].findall("Attribute")}
     assert names == {"u", "v", "stress", *(f"stress_{c}" for c in ("xx", "yy", "zz", "yz", "xz",
-                                                                   "xy"))}
+                                                                   "xy")),
+                     "volume", "material", "part"}          # /geometry, at every frame
+    part = next(a for a in grids[3].findall("Attribute") if a.get("Name") == "part")
+    item = part.find("DataItem")
+    assert item.get("NumberType") == "Int" and item.text == "run.h5:/geometry/part"
     # frame 3 of u: a HyperSlab for libxdmf2 (children) that Xdmf 3 reads from its text
     # (tests/test_paraview.py opens it with ParaView's readers)
     item = next(a for a in grids[3].findall("Attribute") if a.get("Name") == "u").find("DataItem")

@@ -77,11 +77,11 @@ def test_level_schedule():
 
 
 @pytest.mark.parametrize("override,key,word", [
-    ("time.multirate={max_ratio=3}", "time.multirate", "max_ratio"),
-    ("time.multirate={max_ratio=16}", "time.multirate", "max_ratio"),
-    ("time.multirate={safety=0.0}", "time.multirate", "safety"),
-    ("time.multirate={safety=1.5}", "time.multirate", "safety"),
-    ("time.multirate={ratio=4}", "time.multirate", "ratio"),
+    ("time.multirate={max_ratio=3}", "time.multirate.max_ratio", "max_ratio"),
+    ("time.multirate={max_ratio=16}", "time.multirate.max_ratio", "max_ratio"),
+    ("time.multirate={safety=0.0}", "time.multirate.safety", "safety"),
+    ("time.multirate={safety=1.5}", "time.multirate.safety", "safety"),
+    ("time.multirate={ratio=4}", "time.multirate.ratio", "unknown key"),
     ("time.multirate={max_ratio=8}", "time.steps", "max_ratio = 8"),     # 300 steps
     ("time.multirate={max_ratio=4}", "output.every", "max_ratio = 4"),     # every = 5
 ])
