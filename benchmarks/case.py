@@ -134,10 +134,26 @@ def refreshed(case):
     return make
 
 
+def rockmass(case):
+    """The case as a rock mass (README, "The rock mass"): its rock jittered by 0.2 dx
+    and with Weibull strength (m = 6) on sigma_st and T — the price of both beside
+    the plain case."""
+    def make(n: int, steps: int) -> dict:
+        d = case(n, steps)
+        d["scene"]["name"] += "_rockmass"
+        d["parts"][-1]["jitter"] = 0.2
+        d["materials"]["granite"]["heterogeneity"] = {
+            "distribution": "weibull", "modulus": 6.0, "seed": 1, "applies_to": ["tension", "T"]}
+        return d
+    make.__doc__ = f"{case.__name__} as a rock mass"
+    return make
+
+
 CASES = {"elastic": elastic_block, "jh2": jh2_block, "blast": blast_slice,
          "blast_mr": blast_paper_slice, "jh2_refresh": refreshed(jh2_block),
          "blast_refresh": refreshed(blast_slice),
-         "blast_paper_slice": multirate_pair(blast_paper_slice)}
+         "blast_paper_slice": multirate_pair(blast_paper_slice),
+         "jh2_rockmass": rockmass(jh2_block)}
 
 
 def main():

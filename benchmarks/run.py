@@ -18,7 +18,8 @@ def main():
     ap.add_argument("--size", type=int, default=60, help="block edge in points (60 -> 216k)")
     ap.add_argument("--steps", type=int, default=20)
     ap.add_argument("--ranks", default="1,2")
-    ap.add_argument("--cases", default="elastic,jh2,blast,blast_mr,jh2_refresh,blast_refresh,blast_paper_slice")
+    ap.add_argument("--cases", default="elastic,jh2,blast,blast_mr,jh2_refresh,blast_refresh,"
+                                       "blast_paper_slice,jh2_rockmass")
     ap.add_argument("--no-peer", action="store_true")
     args = ap.parse_args()
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
