@@ -115,7 +115,7 @@ def _section(frag, label, z):
     zlo = team.min(float(zs.min()) if len(zs) else np.inf)
     zhi = team.max(float(zs.max()) if len(zs) else -np.inf)
     zc = 0.5 * (zlo + zhi) if z is None else z
-    levels = frag.table.z
+    levels = frag.table.z[np.isin(frag.table.part, frag.parts)]     # the analysed parts' levels
     zl = float(levels[np.argmin(np.abs(levels - zc))])
     lay = frag.table.z[frag.layer]
     sel = (np.abs(lay - zl) < 1e-12) & (label >= 0)

@@ -160,7 +160,8 @@ class Fragments:
         recv, send = self.slabs.plan(team.rank)
         self.halo = Halo(team.comm, recv, send, p.n_owned, p.n_local)
         gas = set(scene.gas_parts)
-        self.keep = np.isin(p.part, [k for k in parts if k not in gas])
+        self.parts = [k for k in parts if k not in gas]      # the analysed parts
+        self.keep = np.isin(p.part, self.parts)
         tl = ~np.isin(p.part, list(gas))
         self.families = build_families(p.x, p.gid, p.horizon, p.n_owned,
                                        tl=tl if gas else None)
