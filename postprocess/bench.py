@@ -81,6 +81,7 @@ def bench_metrics(path, comm) -> dict:
         top = run.max_array(top)
         centres = (np.arange(nb) + 0.5) * dx
         t_end = float(run.time[last])
+        commit = str(run.attr("git_commit", ""))[:7]
     finally:
         run.close()
     use = (centres > 2 * r_hole) & (top > 1e-3)
@@ -92,7 +93,8 @@ def bench_metrics(path, comm) -> dict:
         ss = np.sum((np.log(top[use]) - np.log(top[use]).mean()) ** 2)
         fit = {"K": float(math.exp(a)), "beta": float(-b), "r2": float(1 - np.sum(res ** 2) / ss),
                "d_range_mm": [float(centres[use].min() * 1e3), float(centres[use].max() * 1e3)]}
-    return {"t_end_us": t_end * 1e6, "y_row_mm": y_row * 1e3, "burden_mm": (y_row - rock.shape.lo[1]) * 1e3,
+    return {"commit": commit, "t_end_us": t_end * 1e6, "y_row_mm": y_row * 1e3,
+            "burden_mm": (y_row - rock.shape.lo[1]) * 1e3,
             "overbreak_mm": depth * 1e3, "damaged_fraction_behind": n_hit / max(n_behind, 1),
             "ppv_d_mm": (centres * 1e3).tolist(), "ppv_m_s": top.tolist(), "ppv_fit": fit}
 
@@ -125,7 +127,8 @@ def _get(d, *keys):
 
 def _table(rows, runs) -> str:
     labels = list(rows)
-    spec = [("fragments (>= 8 points)", lambda r: _get(r, "fragments", "fragments"), "{}"),
+    spec = [("run made at commit", lambda r: r.get("commit"), "{}"),
+            ("fragments (>= 8 points)", lambda r: _get(r, "fragments", "fragments"), "{}"),
             ("X20 (mm)", lambda r: _mm(_get(r, "fragments", "x20")), "{:.3g}"),
             ("X50 (mm)", lambda r: _mm(_get(r, "fragments", "x50")), "{:.3g}"),
             ("X80 (mm)", lambda r: _mm(_get(r, "fragments", "x80")), "{:.3g}"),
