@@ -166,10 +166,9 @@ class Fragments:
         self.families = build_families(p.x, p.gid, p.horizon, p.n_owned,
                                        tl=tl if gas else None)
         self.gid_range = self.slabs.gid_range(team.rank)
-        a, _ = self.slabs.owned(team.rank)
+        a, b = self.slabs.owned(team.rank)
         # the layer of every owned point (layers are contiguous gid blocks)
-        counts = table.count[a:self.slabs.owned(team.rank)[1]]
-        self.layer = np.repeat(np.arange(a, a + len(counts)), counts)
+        self.layer = np.repeat(np.arange(a, b), table.count[a:b])
 
     def mark_broken(self, pairs: np.ndarray, damage=None, threshold=None):
         """Set the families' broken flags from the frame's (gid_lo, gid_hi) pairs (those

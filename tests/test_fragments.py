@@ -44,12 +44,11 @@ fields = ["u"]
 
 
 def fragments(tmp_path, run, ranks, *extra):
-    out = tmp_path / f"frag{ranks}"
-    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), "python", "-m", "postprocess",
-           "fragments", str(run), "--out", str(out), "--min-points", "1", *extra]
     import subprocess
     import sys
-    cmd[4] = sys.executable
+    out = tmp_path / f"frag{ranks}"
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "postprocess",
+           "fragments", str(run), "--out", str(out), "--min-points", "1", *extra]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=child_env())
     assert res.returncode == 0, res.stdout + res.stderr
     return out

@@ -75,15 +75,10 @@ class Distribution:
         return target in self.applies_to
 
     def factors(self, gid) -> np.ndarray:
-        """The factor of each point (its global id)."""
+        """The factor of each point (its global id): F^-1(u), with ``inverse_cdf`` and
+        ``variation`` (the factor's coefficient of variation) given by each registered
+        distribution."""
         return self.inverse_cdf(uniform(self.seed, STREAM_STRENGTH, gid))
-
-    def inverse_cdf(self, u: np.ndarray) -> np.ndarray:
-        raise NotImplementedError
-
-    def variation(self) -> float:
-        """The factor's coefficient of variation (= its standard deviation)."""
-        raise NotImplementedError
 
 
 @DISTRIBUTIONS.register("weibull")
