@@ -121,15 +121,26 @@ class Simulation:
         if self.interface is not None:
             self.interface.register(st)
             self.corr.attach_interface(self.interface)      # a post-gather step of corr
-        # damping (Eq. 41 for phi = 1, and the gas's own), only if some is asked for
-        needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts)
+        # damping (Eq. 41 for phi = 1, the gas's own, absorbing layers), only if some
+        # is asked for; ``damp_base``: the absorbing layers' (solids only)
+        layers = [bc for bc in scene.boundaries if hasattr(bc, "damping")]
+        needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts) or bool(layers)
         self.damp = st.add("damp", "solver", np.zeros(n if needs_damp else 0))
+        self.damp_base = st.add("damp_base", "solver", np.zeros(n if layers else 0))
+        if layers:
+            c_p = np.array([scene.materials[m].p_wave_speed for m in names])[p.material[:n]]
+            for bc in layers:
+                np.maximum(self.damp_base, bc.damping(p.x[:n], c_p), out=self.damp_base)
+            self.damp_base[~self.tl[:n]] = 0.0
+            self.damp[:] = self.damp_base
         # failure and bond breakage exist only if some material can fail
         self.ledger = Ledger(n, damped=len(self.damp) > 0, viscous=sv.viscosity is not None,
-                             n_interface=len(self.interface.idx) if self.interface else 0)
+                             n_interface=len(self.interface.idx) if self.interface else 0,
+                             layer=np.flatnonzero(self.damp_base > 0))
         self.ledger.register(st, self.interface)
         self.failure = (Failure(p, self.families, self.halo, self.corr, sv.damping, self.damp,
-                                self.tl, self.mode, self.ledger) if scene.can_fail else None)
+                                self.tl, self.mode, self.ledger, self.damp_base)
+                        if scene.can_fail else None)
         if self.failure is not None:
             self.failure.register(st)
             if self.classes.enabled:            # multi-rate's breakage clock

@@ -18,7 +18,9 @@ judges a bench blast by, for one or several runs side by side (the delay cases o
 
 The holes and the free face come from the run's scene: a box rock with
 ``holes`` (mpipd.input.geometry.Box); the free face is the box side nearest the
-row (y = lo).  Writes ``bench.md``, ``bench.json`` and two PNGs (the passing
+row (y = lo).  Rock in an absorbing layer (mpipd.input.loads.Absorbing: the rock
+mass beyond the model) is left out of overbreak and PPV: it is damped, not rock
+that the blast sees as such.  Writes ``bench.md``, ``bench.json`` and two PNGs (the passing
 curves and PPV against distance) into ``--out``, and each run's fragment files
 into ``--out/<label>/``.
 """
@@ -67,7 +69,11 @@ def bench_metrics(path, comm) -> dict:
         ppv = run.field("peak_speed", last)
         mode = run.field("failure_mode", last) if run.has_field("failure_mode") else None
         d = x[:, 1] - y_row
-        behind = mine & (d > r_hole)
+        layer = np.zeros(len(x), dtype=bool)
+        for bc in scene.boundaries:
+            if hasattr(bc, "damping"):
+                layer |= bc.damping(x, np.ones(len(x))) > 0
+        behind = mine & (d > r_hole) & ~layer
         hit = behind & ((dmg >= DAMAGED) | (mode > 0 if mode is not None else False))
         depth = run.max(float(d[hit].max()) if hit.any() else 0.0)
         n_behind = run.sum_int(int(behind.sum()))

@@ -1,8 +1,6 @@
 """The run's energy ledger, ``/energy/<term>`` (J, one value per frame).
 
-Terms (mpipd.model.ledger, which defines them): held = kinetic + integrator + elastic +
-hourglass + spring + contact + gas; dissipated = plastic + removed + contact_onset +
-viscous + damping + gas_damping + interface;
+Terms: mpipd.model.ledger's HELD and DISSIPATED (defined there, with what each means);
 the books close as initial + external = held + dissipated, and ``balance`` is the
 relative closure error (initial + external - held - dissipated) / scale.
 

@@ -146,6 +146,17 @@ def _fit(pts, key) -> dict:
         return na(f"{e} (probes whose peak is at the end of the record are left out)")
 
 
+def failure_time(q) -> float | None:
+    """Time (s, of the state sampled: ``t_state`` where recorded) of the first sample at
+    which the probe's point has failed: zero strength and zero deviatoric stress (a failed
+    point carries neither); None if it never fails or records no strength."""
+    st = np.asarray(q["strength"], float)
+    failed = np.flatnonzero(np.isfinite(st) & (st == 0) & (np.asarray(q["s"]) == 0))
+    if not len(failed):
+        return None
+    return float(np.asarray(q.get("t_state", q["t"]), float)[failed[0]])
+
+
 def wave_speed(probes, radial: dict) -> dict:
     """First-arrival speed over A–G (judged), with the paper's peak-arrival speed beside
     it (``peak_arrival``, information)."""
@@ -156,7 +167,8 @@ def wave_speed(probes, radial: dict) -> dict:
     rows, skipped = [], {}
     for p in pts:
         q = probes[p["name"]]
-        a = arrivals.first_arrival(*arrivals.state_samples(q, -q["sigma_rr"]))
+        a = arrivals.first_arrival(*arrivals.state_samples(q, -q["sigma_rr"]),
+                                   t_failed=failure_time(q))
         if "not_available" in a:
             skipped[p["name"]] = a["not_available"]
             continue
@@ -189,7 +201,7 @@ def _threshold_study(probes, names, d) -> list[dict]:
     out = []
     for frac in arrivals.STUDY:
         t = [arrivals.first_arrival(*arrivals.state_samples(probes[n], -probes[n]["sigma_rr"]),
-                                    frac) for n in names]
+                                    frac, failure_time(probes[n])) for n in names]
         row = {"fraction": frac}
         if any("not_available" in a for a in t):
             row["not_available"] = "; ".join(f"{n}: {a['not_available']}"
@@ -260,13 +272,13 @@ def pressure_stress(probes) -> dict:
         st = q["strength"]
         yl = np.flatnonzero(np.isfinite(st) & (st > 0) & (q["s"] >= YIELD_TOL * st))
         first = int(yl[0]) if len(yl) else None
-        failed = np.flatnonzero(np.isfinite(st) & (st == 0) & (q["s"] == 0))
+        tf = failure_time(q)
         pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": PATHS[n],
                     "peak_p_MPa": float(q["p"].max()) / 1e6,
                     "peak_s_MPa": float(q["s"].max()) / 1e6,
                     "yielded": first is not None,
                     "p_at_yield_MPa": None if first is None else float(q["p"][first]) / 1e6,
                     "s_at_yield_MPa": None if first is None else float(q["s"][first]) / 1e6,
-                    "failed_at_us": float(q["t"][failed[0]]) * 1e6 if len(failed) else None,
+                    "failed_at_us": None if tf is None else tf * 1e6,
                     "strength_recorded": bool(np.isfinite(st).any())})
     return {"points": pts, "missing": missing, "errors": bad}

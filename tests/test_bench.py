@@ -38,10 +38,10 @@ def test_box_holes_are_empty_and_the_tubes_fit_them():
         r2 = (x - h.center[0]) ** 2 + (y - h.center[1]) ** 2
         assert r2.min() >= h.radius ** 2
         assert r2.min() < (h.radius + rock.dx) ** 2          # the wall is the next lattice ring
-    full = (80 * 50)                                          # 1 mm cells of the 80 x 50 mm box
+    full = (80 * 70)                                          # 1 mm cells of the 80 x 70 mm box
     holes = full - len(x)
     assert 3 * 28 <= holes <= 3 * 40                         # ~ pi 3.2^2 = 32 cells a hole
-    assert rock.shape.area == pytest.approx(0.08 * 0.05 - 3 * np.pi * 0.0032 ** 2)
+    assert rock.shape.area == pytest.approx(0.08 * 0.07 - 3 * np.pi * 0.0032 ** 2)
 
 
 def test_bad_initiation_and_holes(tmp_path):

@@ -96,6 +96,69 @@ def test_jwl_pressure_at_unreacted_density(team):
     np.testing.assert_allclose(p, want, rtol=1e-12)
 
 
+@pytest.mark.parametrize("lit", [False, True])
+def test_an_unlit_charge_resists_compression_with_its_hugoniot(team, lit):
+    """A uniform compression rate v = -a x over the charge, tube and rock (an affine
+    field: tr L = -3a exactly at every gas point with a full family): after one step,
+    V_R = exp(-3a dt).  Unlit (t < 0) the pressure is the unreacted Hugoniot's,
+    rho0 c0^2 eta / (1 - s eta)^2 with eta = 1 - V_R, and e gains the trapezoidal work
+    p b / 2 (b = -3a dt per initial volume); without an unreacted EOS the unlit charge
+    carries nothing, and once lit (lam = 1) the pressure is JWL's alone."""
+    c0, s_h, a = 2300.0, 2.0, 2.0e5
+    sets = ["parts.0.shape.z=[0.0, 0.004]", "parts.1.shape.z=[0.0, 0.004]",
+            "parts.2.shape.z=[0.0, 0.004]"]
+    out = {}
+    for name, extra in (("bare", []), ("unreacted",
+                                       [f"materials.explosive.unreacted={{c0={c0}, s={s_h}}}"])):
+        scene, _ = sc.load("detonation_tube", sets + extra)
+        sim = Simulation(scene, team)
+        dt = scene.time.dt
+        sim.v[:] = -a * sim.points.x
+        sim.gas.update(sim.u, sim.v, dt, 1.0 if lit else -1.0)
+        g = sim.gas
+        full = g.offsets[g.gas_idx + 1] - g.offsets[g.gas_idx] >= 30     # interior points
+        out[name] = (g.gd[g.gas_idx, 7][full], g.e[full], (g.gd[g.gas_idx, 6] / g.V0)[full])
+    VR = math.exp(-3.0 * a * dt)
+    p_bare, e_bare, vr = out["bare"]
+    p_u, e_u, vr_u = out["unreacted"]
+    assert len(vr) > 50
+    np.testing.assert_allclose(vr, VR, rtol=1e-12)
+    np.testing.assert_allclose(vr_u, VR, rtol=1e-12)
+    if not lit:
+        eta = 1.0 - VR
+        want = 1320.0 * c0 ** 2 * eta / (1.0 - s_h * eta) ** 2
+        assert want > 1e6
+        np.testing.assert_allclose(p_u, want, rtol=1e-9)
+        np.testing.assert_allclose(e_u, 7.38e9 + 0.5 * want * 3.0 * a * dt, rtol=1e-12)
+        assert np.all(p_bare == 0.0) and np.all(e_bare == 7.38e9)
+    else:
+        np.testing.assert_array_equal(p_u, p_bare)
+        np.testing.assert_array_equal(e_u, e_bare)
+
+
+def test_a_porous_charge_compacts_freely_then_follows_the_solid_hugoniot():
+    """PETN at 1320 kg/m^3 over a solid of 1760 (Saenz & Stewart 2008: c0 2300 m/s,
+    s 2.5): no pressure until V_R = 1320/1760 = 0.75; below it the solid's Hugoniot
+    pressure rho_s U_s u_p, with u_p = eta U_s (mass balance) and U_s = c0 + s u_p, i.e.
+    u_p = c0 eta / (1 - s eta), computed here from the shock relations; the scene's
+    unreacted table gives the kernel's (K, s, a)."""
+    from mpipd.materials.jwl import unreacted_pressure
+    scene, _ = sc.load("blast_bench", [
+        "materials.explosive.unreacted={c0=2300.0, s=2.5, solid_density=1760.0}"])
+    K, s_h, a = scene.materials["explosive"].unreacted_eos
+    assert K == pytest.approx(1760.0 * 2300.0 ** 2) and s_h == 2.5 and a == pytest.approx(1760.0 / 1320.0)
+    for VR in (1.2, 1.0, 0.9, 0.76, 0.75):
+        assert unreacted_pressure(VR, K, s_h, a) == 0.0
+    for VR in (0.74, 0.72, 0.70, 0.65):
+        eta = 1.0 - 1760.0 / (1320.0 / VR)          # 1 - rho_s / rho
+        up = 2300.0 * eta / (1.0 - 2.5 * eta)
+        us = 2300.0 + 2.5 * up
+        assert unreacted_pressure(VR, K, s_h, a) == pytest.approx(1760.0 * us * up, rel=1e-12)
+    assert unreacted_pressure(0.7, 0.0, 2.5, a) == 0.0                 # no unreacted EOS
+    with pytest.raises(sc.SceneError, match="solid_density"):
+        sc.load("blast_bench", ["materials.explosive.unreacted={c0=2300.0, solid_density=1000.0}"])
+
+
 def test_the_gas_is_its_own_model_family(team):
     """The explosive is the "ul" model (mpipd.model.gas), built from the scene beside
     the correspondence solids: no material group, history or stress update of the

@@ -64,7 +64,7 @@ def gaussian(t, t0, width):
 
 
 LEDGER = ("t", "kinetic", "integrator", "elastic", "plastic", "hourglass", "spring", "contact",
-          "gas", "removed", "viscous", "damping", "gas_damping", "interface", "external",
+          "gas", "removed", "viscous", "damping", "gas_damping", "absorbed", "interface", "external",
           "initial", "balance")
 # the every-step peaks at the last frame (synthetic, known): gas 7 GPa x (1 + z/100 mm),
 # rock -sigma_rr 1 GPa (R_b / r)^2 and p 0.6 of it, speed 10 / (1 + d/mm) m/s
@@ -152,9 +152,11 @@ def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5, legacy=False)
     return x, part
 
 
-def put_probe(path, name, gid, sigma_rr, t=None, part=None):
+def put_probe(path, name, gid, sigma_rr, t=None, part=None, strength=None):
     """Replace (or add) probe ``name`` at ``gid`` with record -sigma_rr = ``-sigma_rr``;
-    ``part`` -> the part attributes of the current layout (None: a legacy probe)."""
+    ``part`` -> the part attributes of the current layout (None: a legacy probe);
+    ``strength``: the record of the point's strength (default 1 Pa: intact throughout;
+    a failed point has strength 0 and s 0)."""
     with h5py.File(path, "r+") as f:
         if f"probes/{name}" in f:
             del f[f"probes/{name}"]
@@ -169,8 +171,9 @@ def put_probe(path, name, gid, sigma_rr, t=None, part=None):
                             part=names[int(f["geometry/part"][gid])], material="")
         pg["t"] = t
         pg["sigma_rr"] = sigma_rr
-        for q in ("v_r", "p", "s", "strength"):
+        for q in ("v_r", "p", "s"):
             pg[q] = np.zeros_like(t)
+        pg["strength"] = np.ones_like(t) if strength is None else strength
 
 
 def analyse(path):
@@ -446,13 +449,16 @@ def series_gids(x, part, dists_mm):
     return gids, r[gids] - R_WALL
 
 
-def put_series(path, arrivals_fn, names="ABCDEFG", dists_mm=(4, 7, 10, 13, 17, 21, 25)):
-    """Probes A-G on rock points at ``dists_mm`` carrying ``arrivals_fn(name, d, t)``."""
+def put_series(path, arrivals_fn, names="ABCDEFG", dists_mm=(4, 7, 10, 13, 17, 21, 25),
+               strength_fn=None):
+    """Probes A-G on rock points at ``dists_mm`` carrying ``arrivals_fn(name, d, t)``
+    (and the strength record ``strength_fn(name, t)``, default intact)."""
     x, part = lattice()
     gids, d = series_gids(x, part, dists_mm)
     t = np.arange(1501) * DT
     for n, g, dd in zip(names, gids, d):
-        put_probe(path, n, g, -arrivals_fn(n, dd, t), t=t, part="rock")
+        put_probe(path, n, g, -arrivals_fn(n, dd, t), t=t, part="rock",
+                  strength=None if strength_fn is None else strength_fn(n, t))
     return dict(zip(names, d))
 
 
@@ -511,6 +517,48 @@ def test_first_arrival_threshold_is_the_first_pulses():
     b = first_arrival(t, rising)
     assert b["threshold_Pa"] == pytest.approx(10.0) and b["peak_in_first_pulse"]
     assert b["t_s"] == pytest.approx(1.5, abs=1e-12)
+
+
+def test_a_probe_that_fails_in_its_first_pulse_has_no_arrival(tmp_path):
+    """A, next to the borehole, is loaded by a ramp that rises for 2.5 µs to 200 MPa and
+    then the point fails (stress and strength 0), as at blast_paper:dx1.2's probe A: 10 %
+    of that failure stress is reached after B has arrived, so A's "arrival" would put
+    the times out of order.  A has no arrival, says why, and the speed over B-G (clean
+    half-sines) is c_P; the same ramp at a point that does not fail keeps its arrival,
+    and the threshold study leaves A out as the judged fit does."""
+    from postprocess.arrivals import first_arrival
+    path = tmp_path / "run.h5"
+    write_run(path)
+    T, t0, t_fail = 2e-6, 0.5e-6, 3.0e-6
+
+    def load(n, d, t):
+        if n == "A":
+            return np.where(t < t_fail, 200e6 * np.clip((t - t0) / 2.5e-6, 0.0, 1.0), 0.0)
+        return half_sine(t, t0 + d / C_P, T, 50e6 / (d * 1e3))
+
+    def strength(n, t):
+        return np.where(t < t_fail, 1e9, 0.0) if n == "A" else np.full_like(t, 1e9)
+    d = put_series(path, load, strength_fn=strength)
+    m, _ = analyse(path)
+    ws = m["wave_speed"]
+    assert "A" not in ws["probes"] and len(ws["probes"]) == 6
+    assert "during its first pulse" in ws["excluded_no_arrival"]["A"]
+    assert ws["speed_m_s"] == pytest.approx(C_P, rel=1e-5)
+    assert all("A" not in r.get("t_us", []) for r in ws["threshold_study"])
+    assert len(ws["threshold_study"][0]["t_us"]) == 6
+    row = {r["key"]: r for r in m["targets"]}
+    assert row["wave_speed"]["verdict"] == "within" and m["errors"] == []
+    # without the failure the ramp's arrival stands: 10 % of 200 MPa at t0 + 0.25 µs
+    t = np.arange(1501) * DT
+    ramp = 200e6 * np.clip((t - t0) / 2.5e-6, 0.0, 1.0) * (t < 6e-6)
+    a = first_arrival(t, ramp)
+    assert a["t_s"] == pytest.approx(t0 + 0.25e-6, abs=1e-12)
+    b = first_arrival(t, ramp * (t < t_fail), t_failed=t_fail)
+    assert "not_available" in b and b["failed_in_first_pulse"]
+    # a point that fails after its first pulse has passed keeps its arrival
+    pulse = half_sine(t, t0 + d["B"] / C_P, T, 10e6)
+    c = first_arrival(t, pulse, t_failed=t0 + d["B"] / C_P + 2 * T)
+    assert c["t_s"] == pytest.approx(t0 + d["B"] / C_P + T / math.pi * math.asin(0.1), abs=2e-11)
 
 
 def test_first_arrival_of_a_clean_wave_is_exact(tmp_path):

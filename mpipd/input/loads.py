@@ -123,6 +123,60 @@ class Fixed:
         return self.region.contains(x)
 
 
+#: a face of an axis-aligned boundary: (axis, outward sign)
+FACES = {"-x": (0, -1.0), "+x": (0, 1.0), "-y": (1, -1.0), "+y": (1, 1.0),
+         "-z": (2, -1.0), "+z": (2, 1.0)}
+
+
+@BOUNDARIES.register("absorbing")
+@dataclass(frozen=True)
+class Absorbing:
+    """A damping layer that lines the boundary ``face`` ("+y": the plane y = ``at``,
+    the body on the y < at side) to ``thickness`` L inside it, so that a wave leaves
+    through it as into an unbounded body instead of reflecting from a free face
+    (Cerjan, Kosloff, Kosloff & Reshef 1985, Geophysics 50: 705-708, a graded damping
+    taper).  A solid point at depth s into the layer (s = 0 at its inner edge, L at
+    the face) is damped by the velocity-proportional force -rho c v (the damped update
+    of kernels.integrate.kick_drift), with the quadratic profile
+
+        c(s) = c_max (s / L)^2,    c_max = 3 c_p ln(1/R) / L.
+
+    For frequencies well above c, a plane wave in a body damped by c decays as
+    exp(-c x / (2 c_p)); across the layer and back from the face this is
+    exp(-int_0^L c ds / c_p) = exp(-c_max L / (3 c_p)) = R, the design reflection
+    ``reflection`` (c_p: each point's material).  Frequencies near c and below see
+    the gradient and partly reflect: the layer's real reflection is measured
+    (tests/test_absorbing.py).  The gas keeps its own damping.  The work the layer
+    takes is the ledger's ``absorbed``."""
+    face: str
+    at: float
+    thickness: float
+    reflection: float = 0.1
+
+    def check(self, path):
+        if self.face not in FACES:
+            fail(join(path, "face"), f"must be one of {', '.join(FACES)} (got {self.face!r})")
+        positive(self, path, "thickness")
+        if not 0.0 < self.reflection < 1.0:
+            fail(join(path, "reflection"), f"must be in (0, 1) (got {self.reflection!r})")
+
+    def c_max(self, c_p):
+        """The damping coefficient (1/s) at the face for a material of P-wave speed c_p."""
+        return 3.0 * c_p * np.log(1.0 / self.reflection) / self.thickness
+
+    def mask(self, x: np.ndarray) -> np.ndarray:
+        """No point is held fixed."""
+        return np.zeros(len(x), dtype=bool)
+
+    def damping(self, x: np.ndarray, c_p: np.ndarray) -> np.ndarray:
+        """c (1/s) at points x of P-wave speed c_p: c_max (s/L)^2 inside the layer
+        (s capped at L for points on or beyond the face), 0 elsewhere."""
+        axis, sign = FACES[self.face]
+        s = self.thickness - sign * (self.at - x[:, axis])
+        frac = np.clip(s / self.thickness, 0.0, 1.0)
+        return np.where(s > 0.0, self.c_max(c_p) * frac ** 2, 0.0)
+
+
 @dataclass
 class PreparedLoad:
     """A load bound to one rank's points: owned indices and force density per unit load."""

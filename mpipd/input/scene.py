@@ -354,6 +354,18 @@ class Scene:
                 ld.check_parts(self.parts, f"loads[{i}]")
         for i, jt in enumerate(self.joints):
             jt.check_parts(self.parts, f"joints[{i}]")
+        gas = set(self.gas_materials)
+        solids = {p.material for p in self.parts} - gas
+        for i, bc in enumerate(self.boundaries):
+            if not hasattr(bc, "c_max"):
+                continue
+            for m in sorted(solids):
+                cd = float(bc.c_max(self.materials[m].p_wave_speed)) * self.time.dt
+                if cd > 2.0:
+                    fail(f"boundaries[{i}].thickness",
+                         f"the layer's damping at the face, c_max dt = {cd:.3g} for {m!r}, "
+                         f"exceeds 2 (the damped update then reverses velocities): "
+                         f"make the layer thicker or the reflection larger")
         if self.joints and not self.solver.contact:
             fail("solver.contact", "joints need contact (true): the faces of a joint "
                                    "would otherwise pass through each other")

@@ -9,7 +9,10 @@ For an owned gas point i over its current family (gas and the solids it acts on)
     L_i = [sum_j omega_i Ydot (x) Y V_j] M_i^-1           (Eq. 46)
     V_i <- V_i exp(tr L_i dt),  V_R = V_i / V0_i        (volume from tr L)
     e_i <- e_i - (p_i,old + p_i,new)/2 (V_R,new - V_R,old)   (adiabatic, per initial volume)
-    p_i = lambda(t) k JWL(V_R, e_i),  A_i = sigma_i M_i^-1 = -p_i M_i^-1   (Eqs. 47, 48)
+    p_i = lambda(t) k JWL(V_R, e_i) + (1 - lambda) p_u(V_R),  A_i = -p_i M_i^-1   (Eqs. 47, 48)
+
+(p_u: the unreacted explosive's Hugoniot pressure, mpipd.materials.jwl.unreacted_pressure;
+0 without one.)
 
 Energy.  The internal energy changes by exactly the trapezoidal work of the
 point's own force state (what the energy ledger books for every force, the
@@ -27,8 +30,9 @@ b = V^w_i tr L_i dt), and
 
     e^{n+1} V0 = e^n V0 - (W_a + W_b) / 2.
 
-JWL is linear in e, p = lam k (f(V_R) + w e / V_R), so the implicit update has
-the closed form e^{n+1} = (e^n V0 - W_a/2 - lam k f b/2) / (V0 + lam k w b / (2 V_R)).
+JWL is linear in e, p = lam k (f(V_R) + w e / V_R) + (1 - lam) p_u(V_R), so the
+implicit update has the closed form
+e^{n+1} = (e^n V0 - W_a/2 - (lam k f + (1 - lam) p_u) b/2) / (V0 + lam k w b / (2 V_R)).
 The volume itself, V <- V exp(tr L dt), is the EOS's argument.
 
 Per point, the halo carries gd = [A (6, Voigt), V, p].
@@ -38,7 +42,7 @@ import math
 import numba
 import numpy as np
 
-from ..materials.jwl import jwl_cold
+from ..materials.jwl import jwl_cold, unreacted_pressure
 from .layout import GD_P, GD_V
 from .linalg import det3, inv3
 
@@ -58,13 +62,14 @@ def current_bond(y, i, j):
 
 @numba.njit(cache=True)
 def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
-               V0, e, A, B, R1, R2, w, kfac, is_gas):
+               V0, e, A, B, R1, R2, w, kfac, is_gas, K_u=0.0, s_u=0.0, a_u=1.0):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
     (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
     step's pair weights, so the result does not depend on the update order) and
     ``V_pw`` those of the step before (the last force's weights).  Returns the
-    number of gas points with a singular M."""
+    number of gas points with a singular M.  K_u, s_u, a_u: the unreacted EOS
+    (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
     N = np.empty((3, 3))
@@ -141,8 +146,10 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         lk = lam * kfac
         f = jwl_cold(VR, A, B, R1, R2, w)          # Eq. 48 without w e / V
         bb = V_old * trL * dt                   # W_b = p^{n+1} bb (0 if singular)
-        e[k] = (e[k] * V0[k] - 0.5 * W_a - 0.5 * lk * f * bb) / (V0[k] + 0.5 * lk * w * bb / VR)
-        p = lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0
+        pu = (1.0 - lam) * unreacted_pressure(VR, K_u, s_u, a_u)
+        e[k] = ((e[k] * V0[k] - 0.5 * W_a - 0.5 * (lk * f + pu) * bb)
+                / (V0[k] + 0.5 * lk * w * bb / VR))
+        p = (lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0) + pu
         gd[i, GD_V] = V_new
         gd[i, GD_P] = p
         if singular or p == 0.0:

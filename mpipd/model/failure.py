@@ -33,10 +33,11 @@ from ..state import LOCAL
 
 class Failure:
     def __init__(self, points, families, halo, corr, damping: float, damp, tl, mode,
-                 ledger=None):
+                 ledger=None, damp_base=None):
         """``damp`` and ``mode`` are the State's damping coefficients and failure
         flags (mode: local points; written by the materials and the tension model,
-        exchanged and acted on here)."""
+        exchanged and acted on here); ``damp_base``: each point's damping when intact
+        (absorbing layers; empty or None: 0), which a failed point's keeps if larger."""
         self.points = points
         self.families = families
         self.halo = halo
@@ -48,6 +49,8 @@ class Failure:
         self.touched = np.zeros(n, dtype=np.uint8)
         self.damping = damping
         self.damp = damp                        # the simulation's damping array (or empty)
+        self.damp_base = (damp_base if damp_base is not None and len(damp_base)
+                          else np.zeros(len(damp)))
         self.tl = tl[:n]                        # only total-Lagrangian points have damage
         self.tree = cKDTree(points.x)
         self.reach = float(points.horizon.max()) if nl else 0.0
@@ -107,7 +110,7 @@ class Failure:
                                           self.corr.potentials(changed, u))
                 pd_damage(changed, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
                 if self.damping > 0:
-                    self.damp[changed] = np.where(self.phi[changed] >= 1.0, self.damping, 0.0)
+                    self._set_damping(changed)
         self.seconds += time.perf_counter() - t1
         return len(new)
 
@@ -117,7 +120,12 @@ class Failure:
         rows = np.flatnonzero(self.tl).astype(np.int64)
         pd_damage(rows, fam.offsets, fam.nbr, fam.broken, p.volume, self.phi)
         if self.damping > 0:
-            self.damp[rows] = np.where(self.phi[rows] >= 1.0, self.damping, 0.0)
+            self._set_damping(rows)
+
+    def _set_damping(self, rows):
+        """Eq. 41's damping on the rows with phi = 1, over their intact value."""
+        self.damp[rows] = np.maximum(self.damp_base[rows],
+                                     np.where(self.phi[rows] >= 1.0, self.damping, 0.0))
 
     def counts(self) -> np.ndarray:
         """Owned failed points per mode (index = mode)."""

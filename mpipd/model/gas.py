@@ -179,7 +179,7 @@ class Gas(Model):
         self.n_singular = gas_update(
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
-            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas)
+            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, *m.unreacted_eos)
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))

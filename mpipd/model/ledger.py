@@ -26,6 +26,9 @@ Terms (J, global sums over the owned points of every rank)::
                 viscous      minus the work of the artificial viscosity (trapezoid)
                 damping      removed by the damping of phi = 1 points (Eq. 41)
                 gas_damping  removed by the gas damping (§2.6)
+                absorbed     taken out by absorbing layers (mpipd.input.loads.Absorbing):
+                             the damping work of the points in a layer (a layer point
+                             that fails books its Eq. 41 damping here too)
                 interface    minus the work of the ghost-force correction (trapezoid;
                              not a potential force, so of either sign)
                 multirate    the jump of the integrator term where the step classes
@@ -66,12 +69,12 @@ from ..state import AUX, LAST
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
-              "interface", "multirate")
+              "absorbed", "interface", "multirate")
 #: the datasets of /energy in a run file, in this order
 TERMS = ("t",) + HELD + DISSIPATED + ("external", "initial", "balance")
 #: terms that cannot be negative (beyond round-off and O(dt^2) noise)
 NON_NEGATIVE = ("kinetic", "elastic", "hourglass", "spring", "contact", "gas", "plastic",
-                "removed", "viscous", "damping", "gas_damping")
+                "removed", "viscous", "damping", "gas_damping", "absorbed")
 #: |balance| and the negative excursions that :func:`impossible` tolerates
 BALANCE_TOL = 1e-3
 
@@ -92,6 +95,7 @@ class Energies:
     viscous: float = 0.0
     damping: float = 0.0
     gas_damping: float = 0.0
+    absorbed: float = 0.0
     interface: float = 0.0
     multirate: float = 0.0
     external: float = 0.0
@@ -124,7 +128,7 @@ class Energies:
     @classmethod
     def from_record(cls, group, frame: int = -1) -> "Energies":
         """The reading of one frame of a run file's ``/energy`` group (h5py); a term
-        the file predates (``multirate``) reads 0."""
+        the file predates (``multirate``, ``absorbed``) reads 0."""
         return cls(**{f.name: float(group[f.name][frame]) if f.name in group else 0.0
                       for f in fields(cls)})
 
@@ -148,8 +152,11 @@ class Ledger:
     previous step's viscous and interface forces are kept for the trapezoid.
     """
 
-    def __init__(self, n_owned: int, damped: bool, viscous: bool, n_interface: int):
+    def __init__(self, n_owned: int, damped: bool, viscous: bool, n_interface: int,
+                 layer=None):
         self.edamp = np.zeros(n_owned if damped else 0)
+        #: owned points in an absorbing layer (their damping work is ``absorbed``)
+        self.layer = np.zeros(0, np.int64) if layer is None else np.asarray(layer, np.int64)
         self.fv = np.zeros((n_owned if viscous else 0, 3))
         self.fv_old = np.zeros_like(self.fv)
         self.fc_old = np.zeros((n_interface, 3))
@@ -225,15 +232,16 @@ class Ledger:
         removed = float(np.dot(vol[gone], c.W[gone])) + self.jumps
         pot = c.potentials(self.rows, sim.u).sum(axis=0)
         gas = sim.gas.energy() if sim.gas is not None else 0.0
-        damping = gas_damping = 0.0
+        damping = gas_damping = absorbed = 0.0
         if len(self.edamp):
             ed = m * self.edamp
             if sim.gas is not None:
                 gas_damping = float(ed[sim.gas.gas_idx].sum())
-            damping = float(ed.sum()) - gas_damping
+            absorbed = float(ed[self.layer].sum())
+            damping = float(ed.sum()) - gas_damping - absorbed
         return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, plastic, removed,
-                         self.contact_jumps, -self.viscous_work, damping, gas_damping, -self.interface_work,
-                         self.reclass, sim.external_work])
+                         self.contact_jumps, -self.viscous_work, damping, gas_damping, absorbed,
+                         -self.interface_work, self.reclass, sim.external_work])
 
     def read(self, sim) -> Energies:
         tot = sim.team.sum(self.local(sim))

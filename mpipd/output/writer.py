@@ -47,7 +47,7 @@ import numpy as np
 from .. import __version__
 from ..input.scene import OUTPUT_FIELDS
 from ..kernels.linalg import VOIGT
-from ..model.ledger import TERMS
+from ..model.ledger import DISSIPATED, HELD, TERMS
 
 
 def git_commit() -> str:
@@ -171,9 +171,8 @@ class Writer:
         self.time = self.f.create_dataset("time", (self.n_frames,), "f8",
                                           **growable((self.n_frames,)))
         eg = self.f.create_group("energy")
-        eg.attrs["doc"] = ("energy ledger (J), see mpipd.model.ledger: held = kinetic + integrator + "
-                           "elastic + hourglass + spring + contact + gas; dissipated = plastic "
-                           "+ removed + viscous + damping + gas_damping + interface; balance = "
+        eg.attrs["doc"] = (f"energy ledger (J), see mpipd.model.ledger: held = {' + '.join(HELD)}; "
+                           f"dissipated = {' + '.join(DISSIPATED)}; balance = "
                            "(initial + external - held - dissipated) / scale")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8",
                                             **growable((self.n_frames,))) for k in TERMS}
