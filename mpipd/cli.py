@@ -313,6 +313,11 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         log(f"mpipd: peak gas pressure {peak / 1e9:.3f} GPa (pressure_factor {m.pressure_factor:g}; "
             f"Table 2 implies p_CJ = {cj['p'] / 1e9:.2f} GPa, D_CJ = {cj['D']:.0f} m/s; "
             f"the paper reports up to 1.8 GPa)")
+        lit = sim.gas.lit_density(team)
+        log("mpipd: density at lighting (x the charge's): " + "; ".join(
+            f"{k} max {v['max']:.3f}, mean {v['mean']:.3f}"
+            + (f", {v['lit_fraction']:.0%} lit" if v["lit_fraction"] < 1 else "")
+            for k, v in lit.items()))
     if sim.probes is not None:
         for name, (srr, vr, pmax) in sim.probes.peaks().items():
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "

@@ -88,6 +88,9 @@ def bench_metrics(path, comm) -> dict:
         centres = (np.arange(nb) + 0.5) * dx
         t_end = float(run.time[last])
         commit = str(run.attr("git_commit", ""))[:7]
+        peak_gas = run.attr("peak_gas_pressure", None)
+        lit = run.attr("density_at_lighting", None)
+        lit = json.loads(str(lit)) if lit is not None else None
     finally:
         run.close()
     use = (centres > 2 * r_hole) & (top > 1e-3)
@@ -100,6 +103,8 @@ def bench_metrics(path, comm) -> dict:
         fit = {"K": float(math.exp(a)), "beta": float(-b), "r2": float(1 - np.sum(res ** 2) / ss),
                "d_range_mm": [float(centres[use].min() * 1e3), float(centres[use].max() * 1e3)]}
     return {"commit": commit, "t_end_us": t_end * 1e6, "y_row_mm": y_row * 1e3,
+            "peak_gas_pressure_GPa": None if peak_gas is None else float(peak_gas) / 1e9,
+            "density_at_lighting_max": (max(v["max"] for v in lit.values()) if lit else None),
             "burden_mm": (y_row - rock.shape.lo[1]) * 1e3,
             "overbreak_mm": depth * 1e3, "damaged_fraction_behind": n_hit / max(n_behind, 1),
             "ppv_d_mm": (centres * 1e3).tolist(), "ppv_m_s": top.tolist(), "ppv_fit": fit}
@@ -149,7 +154,11 @@ def _table(rows, runs) -> str:
              lambda r: r["damaged_fraction_behind"], "{:.3f}"),
             ("PPV fit K (m/s at 1 m: K d^-beta)", lambda r: _get(r, "ppv_fit", "K"), "{:.3g}"),
             ("PPV fit beta", lambda r: _get(r, "ppv_fit", "beta"), "{:.3g}"),
-            ("PPV fit R^2 (log)", lambda r: _get(r, "ppv_fit", "r2"), "{:.3f}")]
+            ("PPV fit R^2 (log)", lambda r: _get(r, "ppv_fit", "r2"), "{:.3f}"),
+            ("peak gas pressure, every step (GPa)", lambda r: r.get("peak_gas_pressure_GPa"),
+             "{:.3g}"),
+            ("largest density of a charge when lit (x its loaded density)",
+             lambda r: r.get("density_at_lighting_max"), "{:.3f}")]
     head = "| quantity | " + " | ".join(labels) + " |\n|---|" + "---|" * len(labels) + "\n"
     body = []
     for name, get, fmt in spec:

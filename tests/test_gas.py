@@ -118,6 +118,14 @@ def test_an_unlit_charge_resists_compression_with_its_hugoniot(team, lit):
         g = sim.gas
         full = g.offsets[g.gas_idx + 1] - g.offsets[g.gas_idx] >= 30     # interior points
         out[name] = (g.gd[g.gas_idx, 7][full], g.e[full], (g.gd[g.gas_idx, 6] / g.V0)[full])
+        # the density at lighting is kept from the step a point is lit
+        vr_all = g.gd[g.gas_idx, 6] / g.V0
+        if lit:
+            np.testing.assert_array_equal(g.vr_lit, vr_all)
+            d = g.lit_density(team)["charge"]
+            assert d["max"] == pytest.approx(1.0 / vr_all.min()) and d["lit_fraction"] == 1.0
+        else:
+            assert np.isnan(g.vr_lit).all()
     VR = math.exp(-3.0 * a * dt)
     p_bare, e_bare, vr = out["bare"]
     p_u, e_u, vr_u = out["unreacted"]

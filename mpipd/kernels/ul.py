@@ -62,13 +62,14 @@ def current_bond(y, i, j):
 
 @numba.njit(cache=True)
 def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
-               V0, e, A, B, R1, R2, w, kfac, is_gas, K_u=0.0, s_u=0.0, a_u=1.0):
+               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, K_u=0.0, s_u=0.0, a_u=1.0):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
     (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
     step's pair weights, so the result does not depend on the update order) and
     ``V_pw`` those of the step before (the last force's weights).  Returns the
-    number of gas points with a singular M.  K_u, s_u, a_u: the unreacted EOS
+    number of gas points with a singular M.  ``vr_lit[k]``: V_R of point k at the
+    step it is first lit (NaN until then).  K_u, s_u, a_u: the unreacted EOS
     (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
@@ -143,6 +144,8 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         lam = 1.0 if t_ramp <= 0.0 else (t - t_lit[k]) / t_ramp
         lam = 0.0 if lam < 0.0 else (1.0 if lam > 1.0 else lam)
         VR = V_new / V0[k]
+        if lam > 0.0 and math.isnan(vr_lit[k]):
+            vr_lit[k] = VR
         lk = lam * kfac
         f = jwl_cold(VR, A, B, R1, R2, w)          # Eq. 48 without w e / V
         bb = V_old * trL * dt                   # W_b = p^{n+1} bb (0 if singular)

@@ -26,7 +26,11 @@ on any rank count and after any restart.  Distributions (registry below):
 No weakest-link size scaling is applied: the factor is per point at the
 scene's dx, so the field's statistics do not change with resolution.  (A
 weakest-link model would scale the median as (V_ref / V)^(1/m), Weibull 1951;
-the refs note cites MOOSE's VolumeWeightedWeibull.)
+the refs note cites MOOSE's VolumeWeightedWeibull.)  A per-point modulus is not
+the specimen's: with a horizon of 3 dx the overlapping bonds narrow the scatter
+(Jones et al., Procedia Struct. Integrity 28 (2020) 1856, Fig. 6: bonds at beta = 6
+gave 2-D specimens beta = 8.65-12.46); the README's rock-mass section gives what
+that means for the modulus of the built-in cases.
 """
 from __future__ import annotations
 

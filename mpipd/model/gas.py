@@ -80,6 +80,8 @@ class Gas(Model):
         self.e = np.full(len(self.gas_idx), self.mat.e0)
         m = self.mat
         self.t_lit = lighting_times(scene, p.part[self.gas_idx], p.x[self.gas_idx, 2], m)
+        self.vr_lit = np.full(len(self.gas_idx), np.nan)     # V_R when first lit
+        self.part_names = [q.name for q in scene.parts]
         dx = float(p.dx[self.gas_idx].max()) if len(self.gas_idx) else 0.0
         self.t_ramp = m.burn_ramp * dx / m.vod
         self.gas_horizon = np.where(self.is_gas.astype(bool), p.horizon, 0.0)
@@ -114,6 +116,7 @@ class Gas(Model):
         add("gas_V_ratio", own, self.V_ratio)
         add("gas_V0", own, self.V0, rows=self.gas_idx)
         add("gas_t_lit", own, self.t_lit, rows=self.gas_idx)
+        add("gas_vr_lit", own, self.vr_lit, rows=self.gas_idx, checkpoint=True)
         add("gas_is_gas", own, self.is_gas, rows=LOCAL)
         add("gas_horizon", own, self.gas_horizon, rows=LOCAL)
         for name in ("eligible", "rows", "gas_idx"):
@@ -179,7 +182,8 @@ class Gas(Model):
         self.n_singular = gas_update(
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
-            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, *m.unreacted_eos)
+            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, self.vr_lit,
+            *m.unreacted_eos)
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
@@ -194,6 +198,26 @@ class Gas(Model):
         y = self.y if self.y is not None else p.x + u
         gas_gather(self.rows, y, p.volume, self.V_w, self.V_ratio, self.gd, p.horizon,
                    self.offsets, self.nbr, self.is_gas, f)
+
+    def lit_density(self, team) -> dict:
+        """Per charge (part name): the largest and the mean density at lighting over
+        its lit points, as multiples of the charge's density (1: lit as loaded; a
+        delayed charge beside fired holes may have been compressed), and the fraction
+        of its points lit (collective)."""
+        out = {}
+        parts = self.points.part[self.gas_idx]
+        for k, name in enumerate(self.part_names):
+            sel = parts == k
+            lit = sel & np.isfinite(self.vr_lit)
+            rho = 1.0 / self.vr_lit[lit]
+            n_all = team.sum(int(sel.sum()))
+            if n_all == 0:
+                continue
+            n_lit = team.sum(int(lit.sum()))
+            mx = team.max(float(rho.max()) if len(rho) else 0.0)
+            mean = team.sum(float(rho.sum())) / max(n_lit, 1)
+            out[name] = {"max": mx, "mean": mean, "lit_fraction": n_lit / n_all}
+        return out
 
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""

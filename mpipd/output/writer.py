@@ -25,6 +25,8 @@ does not depend on the number of ranks that wrote it::
                             set is rows offsets[k]:offsets[k + 1] (sorted by gid_lo);
                             only in a scene that can fail or has joints
     /bonds/offsets          (n_frames + 1,) int64
+    attrs peak_gas_pressure, density_at_lighting (JSON: per charge, the largest and
+                            mean density when lit, x the charge's, and the fraction lit)
 
 Each rank owns one contiguous gid range and writes it as one hyperslab.
 
@@ -243,6 +245,9 @@ class Writer:
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()
         if self.sim.gas is not None:    # every step's peak, not just the frames' (since start/restart)
             self.f.attrs["peak_gas_pressure"] = self.sim.team.max(self.sim.gas.peak_pressure)
+            # per charge: density when lit, x the charge's (mpipd.model.gas.Gas.lit_density)
+            self.f.attrs["density_at_lighting"] = json.dumps(
+                self.sim.gas.lit_density(self.sim.team))
         self.f.close()
         if self.sim.team.root:
             times, geometry = self.time_values()
