@@ -104,7 +104,8 @@ class Scalar:
 
     ``reduce = "sum"``: each rank holds its share; the checkpoint holds the sum and
     a restart gives it to rank 0 (others 0).  ``"same"``: every rank holds the
-    same value."""
+    same value.  ``"max"``: each rank holds its own running maximum; the checkpoint
+    holds the largest and a restart gives it to every rank."""
     name: str
     owner: str
     get: Callable[[], float]
@@ -157,7 +158,7 @@ class State:
     def scalar(self, name: str, owner: str, get, set, reduce: str = "sum"):
         if name in self.scalars:
             raise KeyError(f"state scalar {name!r} registered twice")
-        if reduce not in ("sum", "same"):
+        if reduce not in ("sum", "same", "max"):
             raise ValueError(f"{name}: unknown reduction {reduce!r}")
         self.scalars[name] = Scalar(name, owner, get, set, reduce)
 

@@ -219,6 +219,9 @@ def test_restart_through_the_detonation(tmp_path, det_runs):
             assert np.array_equal(f[k][...], f1[k][...]), k
         # a global sum: equal up to the order of the reduction
         np.testing.assert_allclose(f["energy/gas"][...], f1["energy/gas"][...], rtol=1e-12)
+        # the every-step peak and the density at lighting are the whole run's
+        assert f.attrs["peak_gas_pressure"] == f1.attrs["peak_gas_pressure"]
+        assert f.attrs["density_at_lighting"] == f1.attrs["density_at_lighting"]
 
 
 def test_blast_slice_reports_peak_pressures(tmp_path):

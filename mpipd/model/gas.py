@@ -127,6 +127,9 @@ class Gas(Model):
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
         add("gas_y", own, get=lambda: self.y, rows=AUX)
         state.offer("pressure", own, self.pressure)
+        # the every-step peak, whole run (a restart goes on from it)
+        state.scalar("gas_peak_pressure", own, lambda: self.peak_pressure,
+                     lambda v: setattr(self, "peak_pressure", float(v)), reduce="max")
 
     def after_restore(self, halo):
         """The ghosts' pair weights and the volume ratio from the restored state."""

@@ -89,7 +89,8 @@ def _write(sim, tmp, scene_text, overrides, run_id):
         a["n_points"] = N
         a["ranks"] = team.size
         for s in sim.state.scalars.values():    # loads' work, ledger sums, broken bonds
-            a[s.name] = team.sum(s.get()) if s.reduce == "sum" else s.get()
+            a[s.name] = ({"sum": team.sum, "max": team.max}[s.reduce](s.get())
+                         if s.reduce in ("sum", "max") else s.get())
         if sim.probes is not None:                # the running peaks, whole run
             a["probe_peaks"] = json.dumps(sim.probes.peaks())
         for name, arr in _per_point(sim).items():
@@ -254,7 +255,7 @@ def restore(sim, path) -> None:
     sim.step_count, sim.t = step, t
     for name, s in st.scalars.items():                  # global sums: held once, on rank 0
         v = scalars[name]
-        s.set(v if s.reduce == "same" or team.root else type(v)(0))
+        s.set(v if s.reduce in ("same", "max") or team.root else type(v)(0))
     sim.after_restore()                                 # 2. what follows from it
     for fld in st.checkpointed(REBUILT):                # 3. saved over the rebuild
         fld.load(data[fld.name])
