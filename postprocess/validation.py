@@ -212,8 +212,10 @@ def provenance(runs) -> list[str]:
         ("simulated time (µs)", lambda r: "not in report.json" if r["doc"].get("t_end_us") is None
          else f"{r['doc']['t_end_us']:.4g} ({r['doc'].get('frames', '?')} frames)"),
         ("bonds broken", lambda r: get(r, "bonds_broken")),
-        ("run wall time", lambda r: _wall(r["doc"]["run"].get("segments"))),
-        ("throughput", lambda r: _throughput(r["doc"]["run"].get("segments"))),
+        ("run wall time", lambda r: _wall(r["doc"]["run"].get("segments"),
+                                          r["doc"]["run"].get("steps"))),
+        ("throughput", lambda r: _throughput(r["doc"]["run"].get("segments"),
+                                             r["doc"]["run"].get("steps"))),
         ("impossible values (errors)", lambda r: str(len(r["doc"].get("errors", [])))),
     ]
     L = ["## Provenance", "",
@@ -224,28 +226,52 @@ def provenance(runs) -> list[str]:
     L += ["", "Run wall time and throughput: the time loop's wall time of every `mpipd run` "
           "invocation of the run (a restart adds one; attr `segments` of run.h5, with the "
           "ranks and commit of each), summed; throughput = TL bonds x steps / that time.  "
-          "Runs made before the run file kept its segments show 'not recorded'."]
+          "Runs made before the run file kept its segments show 'not recorded'.  An "
+          "invocation killed before it could write (no clean stop) leaves no segment: "
+          "the steps no segment covers are named, and the time is then a lower bound."]
     return L + [""]
 
 
-def _wall(segments) -> str:
+def uncovered(segments, steps) -> list[tuple[int, int]]:
+    """The step ranges [a, b) of 0..steps that no segment's from_step..to_step covers
+    (an invocation killed before it wrote its segment)."""
+    out, at = [], 0
+    for s in sorted(segments, key=lambda s: s["from_step"]):
+        if s["from_step"] > at:
+            out.append((at, s["from_step"]))
+        at = max(at, s["to_step"])
+    if steps is not None and at < steps:
+        out.append((at, int(steps)))
+    return out
+
+
+def _gaps_text(segments, steps) -> str:
+    gaps = uncovered(segments, steps)
+    return ("; steps " + ", ".join(f"{a}–{b}" for a, b in gaps) + " not recorded"
+            if gaps else "")
+
+
+def _wall(segments, steps=None) -> str:
     """Total loop wall time of a run's invocations, with their count and ranks."""
     if not segments:
         return NOT_RECORDED
     wall = sum(s["wall_s"] for s in segments)
     ranks = sorted({s["ranks"] for s in segments})
-    return (f"{wall / 60:.1f} min ({len(segments)} invocation(s) on "
-            f"{'/'.join(map(str, ranks))} rank(s))")
+    gaps = _gaps_text(segments, steps)
+    return (f"{'at least ' if gaps else ''}{wall / 60:.1f} min ({len(segments)} invocation(s) on "
+            f"{'/'.join(map(str, ranks))} rank(s){gaps})")
 
 
-def _throughput(segments) -> str:
-    """Bond-steps per second over a run's invocations, and per rank."""
+def _throughput(segments, steps=None) -> str:
+    """Bond-steps per second over a run's recorded invocations, and per rank."""
     if not segments or any(s.get("bond_steps_per_s") is None for s in segments):
         return NOT_RECORDED
     wall = sum(s["wall_s"] for s in segments)
     work = sum(s["bond_steps_per_s"] * s["wall_s"] for s in segments)
     per_rank = sum(s["bond_steps_per_s"] / s["ranks"] * s["wall_s"] for s in segments) / wall
-    return f"{work / wall / 1e6:.2f} M bond-steps/s ({per_rank / 1e6:.2f} M per rank)"
+    gaps = _gaps_text(segments, steps)
+    return (f"{work / wall / 1e6:.2f} M bond-steps/s ({per_rank / 1e6:.2f} M per rank)"
+            + (f" over the recorded steps{gaps}" if gaps else ""))
 
 
 def targets_table(runs) -> list[str]:

@@ -248,3 +248,22 @@ def test_make_validate_missing_run(tmp_path):
     assert len(lines) == 1 and str(missing) in lines[0]
     assert "mpipd run blast_paper:dx1.2" in lines[0]
     assert not (tmp_path / "docs").exists()
+
+
+def test_steps_that_no_invocation_recorded_are_named():
+    """An invocation killed before it could write leaves no segment (the 0.8 mm
+    blast_paper run: steps 0-1200 ran, were checkpointed, and the process was killed at
+    1300): the wall time is a lower bound and names the steps it lacks."""
+    segs = [{"from_step": 1200, "to_step": 1940, "ranks": 2, "wall_s": 1600.0,
+             "bond_steps_per_s": 1e6 * 740 / 1600.0},
+            {"from_step": 1940, "to_step": 3000, "ranks": 2, "wall_s": 2400.0,
+             "bond_steps_per_s": 1e6 * 1060 / 2400.0}]
+    assert validation.uncovered(segs, 3000) == [(0, 1200)]
+    assert validation.uncovered(segs, 3200) == [(0, 1200), (3000, 3200)]
+    # a restart from an earlier checkpoint overlaps the last segment: nothing missing
+    assert validation.uncovered([{"from_step": 0, "to_step": 500},
+                                 {"from_step": 400, "to_step": 900}], 900) == []
+    assert validation._wall(segs, 3000) == ("at least 66.7 min (2 invocation(s) on 2 rank(s); "
+                                            "steps 0–1200 not recorded)")
+    assert validation._throughput(segs, 3000).endswith("over the recorded steps; steps "
+                                                       "0–1200 not recorded")
