@@ -291,8 +291,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     n_spring = sim.spring_points()
     failed = sim.failure_counts()
     broken = sim.bonds_broken()
-    rate = sim.n_bonds_global * n_steps / max(wall, 1e-12)
-    log(f"mpipd: done in {wall:.2f} s: {rate / 1e6:.2f} M bond-steps/s, "
+    rate = sim.n_bonds_global * (n_steps - first) / max(wall, 1e-12)    # this invocation's
+    log(f"mpipd: done in {wall:.2f} s" + (f" (steps {first}-{n_steps})" if first else "")
+        + f": {rate / 1e6:.2f} M bond-steps/s, "
         f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}")
     if sim.failure is not None:
         log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))

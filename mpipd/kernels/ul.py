@@ -69,7 +69,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
     step's pair weights, so the result does not depend on the update order) and
     ``V_pw`` those of the step before (the last force's weights).  Returns the
     number of gas points with a singular M.  ``vr_lit[k]``: V_R of point k at the
-    step it is first lit (NaN until then).  K_u, s_u, a_u: the unreacted EOS
+    step it is first lit (0 until then).  K_u, s_u, a_u: the unreacted EOS
     (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
@@ -144,7 +144,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         lam = 1.0 if t_ramp <= 0.0 else (t - t_lit[k]) / t_ramp
         lam = 0.0 if lam < 0.0 else (1.0 if lam > 1.0 else lam)
         VR = V_new / V0[k]
-        if lam > 0.0 and math.isnan(vr_lit[k]):
+        if lam > 0.0 and vr_lit[k] == 0.0:
             vr_lit[k] = VR
         lk = lam * kfac
         f = jwl_cold(VR, A, B, R1, R2, w)          # Eq. 48 without w e / V

@@ -49,8 +49,7 @@ class Failure:
         self.touched = np.zeros(n, dtype=np.uint8)
         self.damping = damping
         self.damp = damp                        # the simulation's damping array (or empty)
-        self.damp_base = (damp_base if damp_base is not None and len(damp_base)
-                          else np.zeros(len(damp)))
+        self.damp_base = damp_base if damp_base is not None else np.zeros(0)
         self.tl = tl[:n]                        # only total-Lagrangian points have damage
         self.tree = cKDTree(points.x)
         self.reach = float(points.horizon.max()) if nl else 0.0
@@ -124,8 +123,9 @@ class Failure:
 
     def _set_damping(self, rows):
         """Eq. 41's damping on the rows with phi = 1, over their intact value."""
-        self.damp[rows] = np.maximum(self.damp_base[rows],
-                                     np.where(self.phi[rows] >= 1.0, self.damping, 0.0))
+        failed = np.where(self.phi[rows] >= 1.0, self.damping, 0.0)
+        self.damp[rows] = (np.maximum(self.damp_base[rows], failed) if len(self.damp_base)
+                           else failed)
 
     def counts(self) -> np.ndarray:
         """Owned failed points per mode (index = mode)."""

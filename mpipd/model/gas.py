@@ -80,7 +80,7 @@ class Gas(Model):
         self.e = np.full(len(self.gas_idx), self.mat.e0)
         m = self.mat
         self.t_lit = lighting_times(scene, p.part[self.gas_idx], p.x[self.gas_idx, 2], m)
-        self.vr_lit = np.full(len(self.gas_idx), np.nan)     # V_R when first lit
+        self.vr_lit = np.zeros(len(self.gas_idx))     # V_R when first lit (0: not yet)
         self.part_names = [q.name for q in scene.parts]
         dx = float(p.dx[self.gas_idx].max()) if len(self.gas_idx) else 0.0
         self.t_ramp = m.burn_ramp * dx / m.vod
@@ -211,7 +211,7 @@ class Gas(Model):
         parts = self.points.part[self.gas_idx]
         for k, name in enumerate(self.part_names):
             sel = parts == k
-            lit = sel & np.isfinite(self.vr_lit)
+            lit = sel & (self.vr_lit > 0)
             rho = 1.0 / self.vr_lit[lit]
             n_all = team.sum(int(sel.sum()))
             if n_all == 0:

@@ -177,6 +177,7 @@ class Ledger:
         state.add("ledger_fv_old", own, self.fv_old, checkpoint=len(self.fv_old) > 0,
                   restore=LAST)
         state.add("ledger_rows", own, self.rows, rows=AUX)
+        state.add("ledger_layer", own, self.layer, rows=AUX)
         if interface is not None:
             state.add("ledger_fc_old", own, self.fc_old, rows=interface.idx, checkpoint=True,
                       restore=LAST)
