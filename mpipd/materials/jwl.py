@@ -153,9 +153,8 @@ class Explosive(JWL):
     ramp the pressure is lam JWL(V, e) + (1 - lam) p_u(V).  Without it (the paper's
     model) unlit gas carries no pressure, which is harmless for one charge lit from
     its end (the front outruns the products, so nothing ahead of it is compressed)
-    but not for a delayed charge beside a fired one: the rock closes its borehole
-    freely and the charge is lit already compressed (blast_bench: peak pressures of
-    19 and 39 GPa, above p_CJ = 15.5 GPa).  The compression work goes into e, so
+    but not for a delayed charge beside a fired one, which the rock may squeeze
+    before it is lit.  The compression work goes into e, so
     the ledger's ``gas`` books it.
     """
     initiation_z: float = 0.0
