@@ -234,16 +234,15 @@ def check_report(scene, ranks: int) -> str:
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")
-    for i, bc in enumerate(scene.boundaries):
-        if hasattr(bc, "c_max"):
-            cs = ", ".join(f"{m} {float(bc.c_max(mat.p_wave_speed)):.3g} 1/s "
-                           f"(c_max dt = {float(bc.c_max(mat.p_wave_speed)) * scene.time.dt:.3g})"
-                           for m, mat in scene.materials.items()
-                           if m not in scene.gas_materials
-                           and any(q.material == m for q in scene.parts))
-            out.append(f"  boundaries[{i}]: absorbing layer lining {bc.face} = {bc.at:g} m, "
-                       f"{bc.thickness * 1e3:g} mm thick, design reflection {bc.reflection:g}: "
-                       f"damping at the face {cs}")
+    for i, bc in scene.absorbing_layers:
+        cs = ", ".join(f"{m} {float(bc.c_max(mat.p_wave_speed)):.3g} 1/s "
+                       f"(c_max dt = {float(bc.c_max(mat.p_wave_speed)) * scene.time.dt:.3g})"
+                       for m, mat in scene.materials.items()
+                       if m not in scene.gas_materials
+                       and any(q.material == m for q in scene.parts))
+        out.append(f"  boundaries[{i}]: absorbing layer lining {bc.face} = {bc.at:g} m, "
+                   f"{bc.thickness * 1e3:g} mm thick, design reflection {bc.reflection:g}: "
+                   f"damping at the face {cs}")
     out.append("  per material (bonds counted from the lattice cross-sections, the model is "
                "not built; the gas's moving families are not counted):")
     for name, mat in scene.materials.items():

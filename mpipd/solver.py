@@ -123,7 +123,7 @@ class Simulation:
             self.corr.attach_interface(self.interface)      # a post-gather step of corr
         # damping (Eq. 41 for phi = 1, the gas's own, absorbing layers), only if some
         # is asked for; ``damp_base``: the absorbing layers' (solids only)
-        layers = [bc for bc in scene.boundaries if hasattr(bc, "damping")]
+        layers = [bc for _, bc in scene.absorbing_layers]
         needs_damp = (sv.damping > 0 and scene.can_fail) or bool(gas_parts) or bool(layers)
         self.damp = st.add("damp", "solver", np.zeros(n if needs_damp else 0))
         self.damp_base = st.add("damp_base", "solver", np.zeros(n if layers else 0))

@@ -70,9 +70,8 @@ def bench_metrics(path, comm) -> dict:
         mode = run.field("failure_mode", last) if run.has_field("failure_mode") else None
         d = x[:, 1] - y_row
         layer = np.zeros(len(x), dtype=bool)
-        for bc in scene.boundaries:
-            if hasattr(bc, "damping"):
-                layer |= bc.damping(x, np.ones(len(x))) > 0
+        for _, bc in scene.absorbing_layers:
+            layer |= bc.damping(x, np.ones(len(x))) > 0
         behind = mine & (d > r_hole) & ~layer
         hit = behind & ((dmg >= DAMAGED) | (mode > 0 if mode is not None else False))
         depth = run.max(float(d[hit].max()) if hit.any() else 0.0)

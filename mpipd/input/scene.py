@@ -50,7 +50,7 @@ from ..materials import MATERIALS
 from ..output.probes import Probe, part_matches
 from .geometry import SHAPES
 from .joints import Joint
-from .loads import BOUNDARIES, INITIAL, LOADS
+from .loads import BOUNDARIES, INITIAL, LOADS, Absorbing
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3
@@ -356,9 +356,7 @@ class Scene:
             jt.check_parts(self.parts, f"joints[{i}]")
         gas = set(self.gas_materials)
         solids = {p.material for p in self.parts} - gas
-        for i, bc in enumerate(self.boundaries):
-            if not hasattr(bc, "c_max"):
-                continue
+        for i, bc in self.absorbing_layers:
             for m in sorted(solids):
                 cd = float(bc.c_max(self.materials[m].p_wave_speed)) * self.time.dt
                 if cd > 2.0:
@@ -411,6 +409,12 @@ class Scene:
         """The materials whose points are the updated-Lagrangian gas (family "ul"),
         in scene order: the one place that tells the gas from the solids."""
         return [m for m, mat in self.materials.items() if mat.family == "ul"]
+
+    @property
+    def absorbing_layers(self) -> list[tuple[int, object]]:
+        """(index in ``boundaries``, layer) of the absorbing layers
+        (mpipd.input.loads.Absorbing): the one place that tells them apart."""
+        return [(i, bc) for i, bc in enumerate(self.boundaries) if isinstance(bc, Absorbing)]
 
     @property
     def gas_parts(self) -> list[int]:
