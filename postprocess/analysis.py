@@ -59,14 +59,14 @@ def _fracture(data_sections, model, last) -> dict:
     for name, z in data_sections["levels"].items():
         if name not in CRACK_SECTIONS:
             continue
-        sec = data_sections["sections"][z]
+        sec = data_sections["sections"][name]
         try:
             failed, crit = cracks.failed_points(sec, last)
         except KeyError as e:
             return {"not_available": str(e).strip("'\"")}
-        args = (sec["x"], sec["y"], failed, model.center, model.dx, model.r_wall, model.r_out)
+        args = (sec["x"], sec["y"], failed, model.center, sec["h"], model.r_wall, model.r_out)
         out[name] = {"z_mm": z * 1e3, "zones": cracks.crack_density(*args),
-                     "radial_cracks": cracks.radial_cracks(*args, horizon=model.horizon),
+                     "radial_cracks": cracks.radial_cracks(*args, horizon=sec["link"]),
                      "crushed_zone": cracks.crushed_zone(*args)}
     names = [n for n in CRACK_SECTIONS if n in out]
     dens = [[out[n]["zones"][k]["density_mm_per_mm2"] for n in names] for k in range(3)]
@@ -82,14 +82,14 @@ def _fracture(data_sections, model, last) -> dict:
 
 def _lattice_bias(data_sections, model, last) -> dict:
     out = {}
-    for name, z in data_sections["levels"].items():
-        sec = data_sections["sections"][z]
+    for name in data_sections["levels"]:
+        sec = data_sections["sections"][name]
         try:
             failed, _ = cracks.failed_points(sec, last)
         except KeyError as e:
             return {"not_available": str(e).strip("'\"")}
-        out[name] = lattice_bias.measure(sec["x"], sec["y"], failed, model.center, model.dx,
-                                         model.r_wall, model.r_out, horizon=model.horizon)
+        out[name] = lattice_bias.measure(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                         model.r_wall, model.r_out, horizon=sec["link"])
     return {**out, "ring": lattice_bias.RING}
 
 
@@ -121,11 +121,11 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     frames = pattern_frames(times, wanted_us=pattern_us)
     if last not in frames:
         frames.append(last)
-    levels = secs.rock_levels(run, model)
-    named = secs.named_levels(levels, model)
+    zoned = secs.named_levels(secs.zone_levels(run, model), model)
+    named = {k: secs.section_z(v, model) for k, v in zoned.items()}
     reqs = [("damage", k) for k in frames] + [("failure_mode", last)]
-    gathered = secs.gather_sections(run, model, list(named.values()), reqs)
-    sec_data = {"levels": named, "sections": gathered}
+    gathered = secs.gather_sections(run, model, zoned, reqs)
+    sec_data = {"levels": named, "zone_levels": zoned, "sections": gathered}
     prof_frames = profile_frames(times)
     vol = volume.scan(run, model, prof_frames)
     plane = (secs.gather_plane(run, model, "pressure", prof_frames)

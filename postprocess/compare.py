@@ -88,7 +88,7 @@ def make_compare(paths, out, comm, labels=None, view="detonation-face") -> list[
         if comm.Get_rank() == 0:
             last = metrics["frames"] - 1
             z = data["sections"]["levels"][section]
-            pictures.append((label, model, data["sections"]["sections"].get(z),
+            pictures.append((label, model, data["sections"]["sections"].get(section),
                              ("damage", last), metrics["t_end_us"], z * 1e3))
             runs.append({"label": label, "run_file": str(Path(path).resolve()),
                          "n_points": n_points, **metrics})

@@ -12,7 +12,8 @@ stands for a crack of length dx (the paper: 0.8 mm per damaged point), so
 
     density_k = n_failed,k * dx / (pi [(R_b + k w)^2 - (R_b + (k-1) w)^2])
 
-in mm/mm^2 (the geometric area of the ring on the section).
+in mm/mm^2 (the geometric area of the ring on the section).  On a section across
+zones of different dx (a graded rock), each failed point stands for its own dx.
 
 Major radial cracks (§3.2: six reach the outer boundary).  A peridynamic model
 does not resolve two cracks closer than its horizon delta, and the failed points
@@ -23,12 +24,17 @@ R_o - 2 dx <= r are split into arcs wherever two neighbours (by angle) are more
 than delta apart along the boundary.  An arc is a major radial crack when its
 crack also reaches zone 1 (r < R_b + w): it runs from the borehole region to the
 boundary.  Spalls and boundary chips that do not connect inward are not counted.
+Across zones, two points are linked within the larger of their horizons, the band
+is 2 dx of each point's own zone, and the arcs' gap is the outer zone's horizon.
 
 Crushed zone (§3.2: "all points within a zone of approximately one radius of the
 borehole are damaged").  The failed fraction is taken in rings of width dx from
 the wall outward; the crushed zone ends at the outer edge of the last ring of
 the unbroken run from the wall in which at least 90 % of the points have
-failed.  Its extent d_c = r_c - R_b is reported, also in borehole radii.
+failed (dx of the finest zone).  Its extent d_c = r_c - R_b is reported, also in
+borehole radii.
+
+Every function takes ``dx`` (and ``horizon``) as one number or as one per point.
 """
 from __future__ import annotations
 
@@ -52,15 +58,21 @@ def zone_edges(r_wall: float, r_out: float) -> np.ndarray:
     return r_wall + (r_out - r_wall) * np.arange(4) / 3.0
 
 
+def per_point(value, x) -> np.ndarray:
+    """A number or one per point, as one float per point of ``x``."""
+    return np.broadcast_to(np.asarray(value, float), np.shape(x)).astype(float)
+
+
 def crack_density(x, y, failed, center, dx, r_wall, r_out) -> list[dict]:
     """Per zone: failed count, crack length (mm), ring area (mm^2), density (mm/mm^2)."""
     r = np.hypot(np.asarray(x) - center[0], np.asarray(y) - center[1])
+    h = per_point(dx, r)
     e = zone_edges(r_wall, r_out)
     out = []
     for k in range(3):
-        inside = (r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * dx))
+        inside = (r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * h))
         n = int(np.count_nonzero(failed & inside))
-        length = n * dx * 1e3
+        length = float(h[failed & inside].sum()) * 1e3
         area = np.pi * (e[k + 1] ** 2 - e[k] ** 2) * 1e6
         out.append({"zone": k + 1, "r_mm": [e[k] * 1e3, e[k + 1] * 1e3], "failed_points": n,
                     "points": int(np.count_nonzero(inside)), "crack_length_mm": length,
@@ -69,14 +81,19 @@ def crack_density(x, y, failed, center, dx, r_wall, r_out) -> list[dict]:
 
 
 def _cracks(x, y, failed, link):
-    """Crack labels per point (0 = not failed): failed points within ``link`` of each
-    other (max-norm) are joined."""
+    """Crack labels per point (0 = not failed): failed points within the larger of
+    their ``link`` (one per point) of each other (max-norm) are joined."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
     idx = np.flatnonzero(failed)
-    pairs = cKDTree(np.column_stack([x[idx], y[idx]])).query_pairs(
-        link * (1 + 1e-9), p=np.inf, output_type="ndarray")
+    pts = np.column_stack([x[idx], y[idx]])
+    li = link[idx]
+    pairs = cKDTree(pts).query_pairs(float(li.max()) * (1 + 1e-9), p=np.inf,
+                                     output_type="ndarray")
+    if li.min() < li.max():
+        d = np.abs(pts[pairs[:, 0]] - pts[pairs[:, 1]]).max(axis=1)
+        pairs = pairs[d <= np.maximum(li[pairs[:, 0]], li[pairs[:, 1]]) * (1 + 1e-9)]
     g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(idx),) * 2)
     _, lab = connected_components(g, directed=False)
     out = np.zeros(len(x), dtype=np.int64)
@@ -87,17 +104,19 @@ def _cracks(x, y, failed, link):
 def radial_cracks(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict:
     """Count of cracks that run from zone 1 to the outer boundary, and their angles."""
     x, y = np.asarray(x, float), np.asarray(y, float)
-    link = 3.0 * dx if horizon is None else horizon
+    h = per_point(dx, x)
+    link = 3.0 * h if horizon is None else per_point(horizon, x)
     r = np.hypot(x - center[0], y - center[1])
-    band = failed & (r >= r_out - BAND * dx)
+    band = failed & (r >= r_out - BAND * h)
     if not np.any(band):
-        return {"count": 0, "angles_deg": [], "boundary_arcs": 0, "link_mm": link * 1e3}
+        return {"count": 0, "angles_deg": [], "boundary_arcs": 0,
+                "link_mm": float(link.max()) * 1e3}
     lab = _cracks(x, y, failed, link)
     inner = set(np.unique(lab[failed & (r < zone_edges(r_wall, r_out)[1])]).tolist()) - {0}
     th = np.arctan2(y[band] - center[1], x[band] - center[0])
     order = np.argsort(th)
     th, lb = th[order], lab[band][order]
-    gap = link / r_out
+    gap = float(link[band].max()) / r_out
     cut = np.flatnonzero(np.diff(th) > gap) + 1
     arcs = np.split(np.arange(len(th)), cut)
     if len(arcs) > 1 and th[0] + 2 * np.pi - th[-1] <= gap:      # wraps across +-pi
@@ -109,12 +128,13 @@ def radial_cracks(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict
             c, s = np.cos(th[a]).mean(), np.sin(th[a]).mean()
             major.append(float(np.degrees(np.arctan2(s, c)) % 360.0))
     return {"count": len(major), "angles_deg": sorted(major), "boundary_arcs": len(arcs),
-            "link_mm": link * 1e3}
+            "link_mm": float(link.max()) * 1e3}
 
 
 def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
     """Outer radius of the unbroken run of >= 90 % failed rings from the wall."""
     r = np.hypot(np.asarray(x) - center[0], np.asarray(y) - center[1])
+    dx = float(per_point(dx, r).min()) if len(r) else float(np.min(dx))
     nb = max(1, int(np.ceil((r_out - r_wall) / dx)))
     k = np.clip(((r - r_wall) / dx).astype(int), 0, nb - 1)
     tot = np.bincount(k, minlength=nb)

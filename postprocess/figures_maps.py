@@ -7,8 +7,9 @@
 * Fig. 7  — pressure on the axial x–z plane at a few times (explosive and rock);
 * Figs. 19, 22 — one section of several runs side by side (``compare``).
 
-Sections are drawn on their lattice (one pixel per point, white off the rock),
-viewed from +z; the borehole wall and the outer boundary are outlined.
+Sections are drawn on their lattice (one pixel per point, white off the rock; a
+zoned rock draws each zone on its own lattice), viewed from +z; the borehole wall
+and the outer boundary are outlined.
 """
 from __future__ import annotations
 
@@ -17,15 +18,26 @@ import numpy as np
 from mpipd.kernels.layout import MODE_LABELS
 
 from .plotting import borehole, pyplot, save
-from .sections import NAMED, lattice_image
+from .sections import NAMED, section_images
 
 MODE_COLORS = ("#d9d9d9", "#d62728", "#1f77b4", "#2ca02c")
 
 
+def _draw_section(ax, sec, key, model, **style):
+    """Every zone's lattice image of a section on ``ax``; the last image drawn."""
+    im, exts = None, []
+    for img, ext in section_images(sec, key, model.center, model.r_out):
+        im = ax.imshow(img, origin="lower", extent=ext, interpolation="nearest", **style)
+        exts.append(ext)
+    if exts:
+        e = np.array(exts)
+        ax.set_xlim(e[:, 0].min(), e[:, 1].max())
+        ax.set_ylim(e[:, 2].min(), e[:, 3].max())
+    return im
+
+
 def _damage_panel(ax, sec, key, model, title):
-    img, ext = lattice_image(sec["x"], sec["y"], sec[key], model.center, model.dx, model.r_out)
-    im = ax.imshow(img, origin="lower", extent=ext, cmap="inferno", vmin=0.0, vmax=1.0,
-                   interpolation="nearest")
+    im = _draw_section(ax, sec, key, model, cmap="inferno", vmin=0.0, vmax=1.0)
     borehole(ax, model)
     ax.set_title(title)
     return im
@@ -40,7 +52,7 @@ def _damage_grid(data, model, times, frames, rows, label, what, out) -> str:
                              figsize=(2.6 * len(frames) + 0.8, 2.6 * len(rows) + 0.6))
     im = None
     for i, name in enumerate(rows):
-        sec = data["sections"][lv[name]]
+        sec = data["sections"][name]
         for j, k in enumerate(frames):
             if ("damage", k) not in sec:
                 axes[i, j].set_axis_off()
@@ -80,11 +92,8 @@ def failure_modes(data, model, times, last, label, out) -> str:
     norm = BoundaryNorm(np.arange(-0.5, 4.5), cmap.N)
     fig, axes = plt.subplots(1, len(names), squeeze=False, figsize=(3.0 * len(names), 3.9))
     for j, name in enumerate(names):
-        sec = data["sections"][lv[name]]
-        img, ext = lattice_image(sec["x"], sec["y"], sec[("failure_mode", last)], model.center,
-                                 model.dx, model.r_out)
-        axes[0, j].imshow(img, origin="lower", extent=ext, cmap=cmap, norm=norm,
-                          interpolation="nearest")
+        sec = data["sections"][name]
+        _draw_section(axes[0, j], sec, ("failure_mode", last), model, cmap=cmap, norm=norm)
         borehole(axes[0, j], model)
         axes[0, j].set_title(f"{name}, z = {lv[name] * 1e3:.2f} mm")
     fig.legend(handles=[Patch(color=c, label=m) for c, m in zip(MODE_COLORS, MODE_LABELS)],

@@ -18,9 +18,12 @@ the largest part.  A rock split into zones (``<rock>.band``, ``<rock>.0``, ...;
 :meth:`mpipd.input.scene.Part.zones`) is all of them: ``rock_ids`` lists every zone,
 R_b is the innermost zone's inner radius, R_o the outermost zone's radius and
 ``wall_dx`` the innermost zone's dx (the wall layer is r < R_b + wall_dx);
-``rock`` stays the zone of the sections and cracks (the one named ``rock``, or the
-first).  The charge is the part of a ``jwl`` material (or ``charge``);
-``explosive`` is its material (JWL constants, Table 2) when the scene parses.
+``rock`` is the reference zone (the one named ``rock``, or the first): the sections
+are named by its z levels and every other zone joins them at its own nearest level
+(:mod:`postprocess.sections`); ``zone_dx`` and ``zone_horizon`` give each zone's dx and
+horizon (from the scene; else dx = V^(1/3) of the zone's points and 3 dx).
+The charge is the part of a ``jwl`` material (or ``charge``); ``explosive`` is its
+material (JWL constants, Table 2) when the scene parses.
 ``peak_center`` is the axis of the run's ``peak_sigma_rr`` field (the scene's
 ``[output] peak_center``, default (0, 0)).
 """
@@ -61,6 +64,8 @@ class Model:
     pressure_factor: float | None = None
     horizon: float | None = None                 # the rock's horizon (m); None -> 3 dx
     rock_ids: tuple = ()                         # part indices of every zone of the rock
+    zone_dx: dict = field(default_factory=dict)       # zone part index -> its dx (m)
+    zone_horizon: dict = field(default_factory=dict)  # zone part index -> its horizon (m)
     wall_dx: float | None = None                 # dx of the rock's innermost zone
     explosive: object = None                     # the charge's JWL material (or None)
     peak_center: tuple = (0.0, 0.0)              # axis of the peak_sigma_rr field
@@ -72,6 +77,18 @@ class Model:
     @property
     def thickness(self) -> float:
         return self.z1 - self.z0
+
+    @property
+    def zone_ids(self) -> tuple:
+        """Every zone of the rock (the reference zone alone if it is not split)."""
+        return tuple(self.rock_ids or (self.rock,))
+
+    def dx_of(self, zone: int) -> float:
+        return float(self.zone_dx.get(zone, self.dx))
+
+    def horizon_of(self, zone: int) -> float:
+        h = self.horizon if self.horizon is not None else 3.0 * self.dx
+        return float(self.zone_horizon.get(zone, h))
 
     def is_rock(self, pid: np.ndarray) -> np.ndarray:
         """Mask of the points (part indices ``pid``) in any zone of the rock."""
@@ -184,7 +201,8 @@ def load_model(run, label: str | None = None) -> Model:
         wall_dx = float(inner.dx)
         if len(zones) > 1:
             notes.append(f"the rock is {len(zones)} zones ({', '.join(z.name for z in zones)}): "
-                         f"sections and cracks use {parts[rock]!r} only (dx {dx * 1e3:g} mm)")
+                         f"sections take each zone at its level nearest {parts[rock]!r}'s, "
+                         "a failed point counts its own zone's dx")
     else:
         if shape is not None:
             notes.append(f"the rock part is a {type(shape).__name__.lower()}, not an annulus: "
@@ -196,6 +214,15 @@ def load_model(run, label: str | None = None) -> Model:
         r_wall = run.min(float(r.min()) if len(r) else np.inf) - 0.5 * dx
         r_out = run.max(float(r.max()) if len(r) else 0.0) + 0.5 * dx
         z0, z1 = lo[2] - 0.5 * dx, hi[2] + 0.5 * dx
+    zone_dx, zone_horizon = {}, {}
+    for k in rock_ids:
+        if parts[k] in sparts:
+            zp = sparts[parts[k]]
+            zone_dx[k], zone_horizon[k] = float(zp.dx), float(zp.horizon)
+        else:
+            v = run.geometry("volume")[pid == k]
+            zone_dx[k] = float(np.cbrt(run.max(float(v.max()) if len(v) else 0.0)))
+            zone_horizon[k] = 3.0 * zone_dx[k]
     density, jh2, pf, explosive, probe_parts = {}, None, None, None, {}
     peak_center = (0.0, 0.0)
     if scene is not None:
@@ -215,6 +242,7 @@ def load_model(run, label: str | None = None) -> Model:
                  r_out=r_out, z0=z0, z1=z1, dx=float(dx), rock=rock, charge=charge,
                  part_names=parts, material_names=mats, density=density, jh2=jh2,
                  pressure_factor=pf, horizon=float(horizon), overrides=sets, notes=notes,
-                 rock_ids=rock_ids, wall_dx=float(wall_dx), explosive=explosive,
+                 rock_ids=rock_ids, zone_dx=zone_dx, zone_horizon=zone_horizon,
+                 wall_dx=float(wall_dx), explosive=explosive,
                  peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts)
 

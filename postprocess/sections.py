@@ -3,9 +3,15 @@
 A cross-section at height z is the z level of the rock lattice nearest z (the
 points of a part lie on that part's z levels; paper Fig. 11 cuts the specimen at
 5 mm, mid-thickness and 45 mm; Fig. 9 views the two end faces, Fig. 12 uses the
-two end sections and the middle one).  A z level is never split between reading
-ranks (:mod:`postprocess.reader`), so its owner reads it with one contiguous
-hyperslab per (field, frame) and sends it to rank 0: one section, never the model.
+two end sections and the middle one).  A rock split into zones (graded rings, an
+inner band: :meth:`mpipd.input.scene.Part.zones`) has one lattice per zone, with
+its own dx and z levels: the section takes, in each zone, that zone's level
+nearest the reference zone's level (``model.rock``), so it spans the whole rock.
+Each point of a section carries its zone's ``h`` (dx) and ``link`` (horizon).
+
+A z level is never split between reading ranks (:mod:`postprocess.reader`), so its
+owner reads it with one contiguous hyperslab per (field, frame) and sends it to
+rank 0: one section, never the model.
 
 The axial plane (paper Figs. 7, 8) is the first lattice row above the axis,
 0 < y - y_c < dx_p of each part p: it runs through every rank's slab and is
@@ -19,55 +25,76 @@ import numpy as np
 NAMED = ("detonation end face", "z0 + 5 mm", "mid-thickness", "z1 - 5 mm", "far end face")
 
 
-def rock_levels(run, model) -> np.ndarray:
-    """Sorted z of every z level holding rock points (same array on every rank)."""
-    rock = (run.geometry("part") == model.rock).astype(np.int64)
-    has = run.per_level(rock) > 0
-    return np.asarray(run.all_levels(run.level_z[has]))
+def zone_levels(run, model) -> dict[int, np.ndarray]:
+    """Rock zone (part index) -> sorted z of its z levels (same on every rank)."""
+    pid = run.geometry("part")
+    out = {}
+    for p in model.zone_ids:
+        has = run.per_level((pid == p).astype(np.int64)) > 0
+        out[p] = np.asarray(run.all_levels(run.level_z[has]))
+    return out
 
 
 def nearest(levels: np.ndarray, z: float) -> float:
     return float(levels[np.argmin(np.abs(levels - z))])
 
 
-def named_levels(levels: np.ndarray, model) -> dict[str, float]:
-    """Section name -> z level, for the faces, +-5 mm from the faces and the middle
-    (duplicates dropped when the specimen is thin)."""
+def named_levels(levels: dict[int, np.ndarray], model) -> dict[str, dict[int, float]]:
+    """Section name -> {zone: z level}, for the faces, +-5 mm from the faces and the
+    middle.  The reference zone's level nearest the wanted height names the section
+    (duplicates dropped when the specimen is thin); every other zone takes its own
+    level nearest that one."""
     z0, z1 = model.z0, model.z1
     want = {NAMED[0]: z0, NAMED[1]: z0 + 5e-3, NAMED[2]: 0.5 * (z0 + z1),
             NAMED[3]: z1 - 5e-3, NAMED[4]: z1}
+    ref = levels[model.rock]
     out, seen = {}, set()
     for name in (NAMED[0], NAMED[4], NAMED[2], NAMED[1], NAMED[3]):
-        z = nearest(levels, want[name])
+        z = nearest(ref, want[name])
         if z not in seen:
-            out[name] = z
+            out[name] = {p: (z if p == model.rock else nearest(lv, z))
+                         for p, lv in levels.items() if len(lv)}
             seen.add(z)
     return {k: out[k] for k in NAMED if k in out}
 
 
-def gather_sections(run, model, zlevels, requests) -> dict | None:
-    """Rock points of each z level in ``zlevels`` with ``requests`` = [(field, frame)]:
-    on rank 0 a dict z -> {"x", "y", (field, frame): values}; None on other ranks.
-    Missing fields are skipped (the caller checks ``run.has_field``)."""
+def section_z(levels: dict[int, float], model) -> float:
+    """The z that names a section: its reference zone's level."""
+    return levels[model.rock]
+
+
+def gather_sections(run, model, named, requests) -> dict | None:
+    """Rock points of each named section (``named``: name -> {zone: z level}) with
+    ``requests`` = [(field, frame)]: on rank 0 a dict name -> {"x", "y", "h",
+    "link", (field, frame): values}, zones in ``model.zone_ids`` order; None on other
+    ranks.  Missing fields are skipped (the caller checks ``run.has_field``)."""
     x = run.geometry("x")
     pid = run.geometry("part")
     local = {}
-    for z in zlevels:
-        idx = np.flatnonzero((pid == model.rock) & (run.z_level == z))
-        if not len(idx):
-            continue
-        a, b = int(idx[0]), int(idx[-1]) + 1
-        sec = {"x": x[idx, 0].copy(), "y": x[idx, 1].copy()}
-        for name, frame in requests:
-            if run.has_field(name):
-                sec[(name, frame)] = run.field(name, frame, span=(a, b))[idx - a]
-        local[z] = sec
+    for name, zl in named.items():
+        for p, z in zl.items():
+            idx = np.flatnonzero((pid == p) & (run.z_level == z))
+            if not len(idx):
+                continue
+            a, b = int(idx[0]), int(idx[-1]) + 1
+            n = len(idx)
+            sec = {"x": x[idx, 0].copy(), "y": x[idx, 1].copy(),
+                   "h": np.full(n, model.dx_of(p)), "link": np.full(n, model.horizon_of(p))}
+            for fname, frame in requests:
+                if run.has_field(fname):
+                    sec[(fname, frame)] = run.field(fname, frame, span=(a, b))[idx - a]
+            local[(name, p)] = sec
     parts = run.comm.gather(local, root=0)
     if not run.root:
         return None
+    got = {}
+    for d in parts:
+        got.update(d)
     out = {}
-    for p in parts:
-        out.update(p)
+    for name in named:
+        chunks = [got[(name, p)] for p in model.zone_ids if (name, p) in got]
+        if chunks:
+            out[name] = {k: np.concatenate([c[k] for c in chunks]) for k in chunks[0]}
     return out
 
 
@@ -101,3 +128,14 @@ def lattice_image(xs, ys, vals, center, dx, r_out):
     ext = np.array([center[0] - n * dx, center[0] + n * dx,
                     center[1] - n * dx, center[1] + n * dx]) * 1e3
     return img, ext
+
+
+def section_images(sec, key, center, r_out) -> list:
+    """One :func:`lattice_image` per lattice of a section (coarsest first, so the
+    finer zones are drawn over it); NaN pixels are transparent."""
+    h = sec["h"]
+    out = []
+    for dx in sorted(np.unique(h), reverse=True):
+        m = h == dx
+        out.append(lattice_image(sec["x"][m], sec["y"][m], sec[key][m], center, float(dx), r_out))
+    return out

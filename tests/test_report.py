@@ -224,6 +224,82 @@ def test_crack_density_of_hand_placed_cracks(tmp_path):
     assert fr["mean_density_mm_per_mm2"][1] == pytest.approx(9.0 / area[1], rel=1e-12)
 
 
+GRADED = SCENE.replace(
+    f'shape = {{ kind = "annulus", center = [0.0, 0.0], inner_radius = {R_WALL}, radius = {R_OUT}',
+    f'grade = {{ dx_outer = {1.5 * DX}, zones = 2 }}\n'
+    f'shape = {{ kind = "annulus", center = [0.0, 0.0], inner_radius = {R_WALL}, radius = {R_OUT}'
+    ).replace(f"z = [0.0, {NZ * DX}]", f"z = [0.0, {6 * DX}]")
+
+
+def graded_run(path):
+    """A rock graded in two zones (3-16.5 mm at dx 1 mm, 16.5-30 mm at 1.5 mm; 6 mm
+    thick, so the zones' z levels differ), one ray failed along +x on each zone's
+    first row above the axis from the wall to the boundary.  Returns the points, their
+    part (1 = inner zone, 2 = outer) and dx, and the failed mask."""
+    from mpipd.input.geometry import Annulus, Cylinder
+    T = 6 * DX
+    shapes = ((0, DX, Cylinder(center=(0.0, 0.0), radius=0.002, z=(0.0, T))),
+              (1, DX, Annulus(center=(0.0, 0.0), radius=16.5e-3, z=(0.0, T), inner_radius=R_WALL)),
+              (2, 1.5 * DX, Annulus(center=(0.0, 0.0), radius=R_OUT, z=(0.0, T),
+                                    inner_radius=16.5e-3)))
+    blocks = []
+    for p, dx, sh in shapes:
+        x, y = sh.cross_section(dx)
+        for z in sh.z_levels(dx):
+            blocks.append((z, p, np.column_stack([x, y, np.full(len(x), z)]), dx))
+    blocks.sort(key=lambda b: (b[0], b[1]))
+    x = np.concatenate([b[2] for b in blocks])
+    part = np.concatenate([np.full(len(b[2]), b[1]) for b in blocks])
+    h = np.concatenate([np.full(len(b[2]), b[3]) for b in blocks])
+    failed = (part > 0) & (np.abs(x[:, 1] - 0.5 * h) < 1e-9) & (x[:, 0] > 0)
+    N = len(x)
+    with h5py.File(path, "w") as f:
+        f.attrs.update(n_points=N, frames_written=1, scene=GRADED, scene_name="graded",
+                       ranks=1, dt=DT, steps=10, git_commit="test", mpipd_version="test")
+        g = f.create_group("geometry")
+        g["x"] = x
+        g["volume"] = h ** 3
+        g["material"] = np.minimum(part, 1).astype("i4")
+        g["material"].attrs["names"] = ["explosive", "granite"]
+        g["part"] = part.astype("i4")
+        g["part"].attrs["names"] = ["charge", "rock.0", "rock.1"]
+        f["time"] = np.array([10 * DT])
+        f["fields/damage"] = failed[None, :].astype(float)
+        f["fields/failure_mode"] = np.where(failed, 3.0, 0.0)[None, :]
+        for name in LEDGER:
+            f[f"energy/{name}"] = np.zeros(1)
+    return x, part, h, failed
+
+
+def test_sections_of_a_graded_rock_span_every_zone(tmp_path):
+    """A section takes each zone at its own level, and each failed point counts its own
+    dx: zone 2 (12-21 mm) holds the inner zone's 1 mm points and the outer zone's
+    1.5 mm points of the ray, zone 3 only 1.5 mm points; the ray is one major crack."""
+    x, part, h, failed = graded_run(tmp_path / "run.h5")
+    m, model = analyse(tmp_path / "run.h5")
+    assert model.zone_ids == (1, 2) and model.rock == 1
+    assert (model.dx_of(1), model.dx_of(2)) == (DX, pytest.approx(1.5 * DX))
+    r = np.hypot(x[:, 0], x[:, 1])
+    edges = [3e-3, 12e-3, 21e-3, 30e-3]
+    one_level = {1: x[:, 2] == x[part == 1, 2].min(), 2: x[:, 2] == x[part == 2, 2].min()}
+    sec_pts = (part == 1) & one_level[1] | (part == 2) & one_level[2]
+    for k in range(3):
+        inside = sec_pts & failed & (r >= edges[k]) & (r < edges[k + 1] + (k == 2) * 1e-3)
+        want_mm = float(h[inside].sum()) * 1e3
+        area = math.pi * (edges[k + 1] ** 2 - edges[k] ** 2) * 1e6
+        for name, sec in m["fracture"]["sections"].items():
+            z = sec["zones"][k]
+            assert z["crack_length_mm"] == pytest.approx(want_mm, rel=1e-12), (name, k)
+            assert z["density_mm_per_mm2"] == pytest.approx(want_mm / area, rel=1e-12)
+    # by hand: zone 2 = 4 inner points (12.5 ... 15.5 mm) x 1 mm + 3 outer (17.25, 18.75,
+    # 20.25 mm) x 1.5 mm; zone 3 = 6 outer points (21.75 ... 29.25 mm) x 1.5 mm
+    zones = next(iter(m["fracture"]["sections"].values()))["zones"]
+    assert [z["crack_length_mm"] for z in zones[1:]] == [pytest.approx(8.5), pytest.approx(9.0)]
+    assert zones[1]["points"] == int(((sec_pts & (r >= 12e-3) & (r < 21e-3))).sum())
+    for sec in m["fracture"]["sections"].values():
+        assert sec["radial_cracks"]["count"] == 1
+
+
 def test_radial_cracks_and_crushed_zone(tmp_path):
     """Six rays from the wall to the boundary (0, 60, ... 300 deg), a short ray at 30 deg,
     a chip at the boundary at 150 deg not connected inward, and a crushed disc r < 6 mm:
