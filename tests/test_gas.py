@@ -167,6 +167,99 @@ def test_a_porous_charge_compacts_freely_then_follows_the_solid_hugoniot():
         sc.load("blast_bench", ["materials.explosive.unreacted={c0=2300.0, solid_density=1000.0}"])
 
 
+VISC = "materials.explosive.viscosity={quadratic=1.5, linear=0.06}"
+
+
+def isentrope_c2(VR, p, rho0=1320.0):
+    """c^2 = -(VR^2 / rho0) dp_s/dVR along the JWL isentrope through (VR, p), by a
+    central difference of JWL.isentrope_pressure (Table 2 constants)."""
+    from mpipd.materials.jwl import JWL
+    j = JWL()
+    C = j.isentrope_constant(VR, p)
+    h = 1e-6 * VR
+    dp = (j.isentrope_pressure(VR + h, C) - j.isentrope_pressure(VR - h, C)) / (2 * h)
+    return -VR * VR / rho0 * dp
+
+
+@pytest.mark.parametrize("a", [2.0e5, -2.0e5, 3.0e7])
+def test_bulk_viscosity_of_a_uniformly_compressed_charge(team, a):
+    """v = -a x, lit: tr L = -3a at every interior gas point.  Compressed (a > 0), q =
+    rho l (1.5 l (3a)^2 + 0.06 c 3a) with rho = rho0 / V_R, l = the charge's dx and c from the JWL
+    isentrope through (V_R, p) (a finite difference here); the pressure p and the energy
+    are those of the run without viscosity, the force state is -(p + q) M^-1, and the
+    work taken out is sum q |b| / 2 (b = V 3a dt).  At a = 3e7 1/s (1.5 |tr L| dt = 2 >
+    1/2) q is held to rho l^2 |tr L| / (2 dt).  Expanding (a < 0): no q."""
+    sets = ["parts.0.shape.z=[0.0, 0.004]", "parts.1.shape.z=[0.0, 0.004]",
+            "parts.2.shape.z=[0.0, 0.004]"]
+    out = {}
+    for name, extra in (("bare", []), ("visc", [VISC])):
+        scene, _ = sc.load("detonation_tube", sets + extra)
+        sim = Simulation(scene, team)
+        dt = scene.time.dt
+        sim.v[:] = -a * sim.points.x
+        sim.gas.update(sim.u, sim.v, dt, 1.0)
+        g = sim.gas
+        full = g.offsets[g.gas_idx + 1] - g.offsets[g.gas_idx] >= 30
+        out[name] = (g.gd[g.gas_idx][full], g.gq[g.gas_idx][full], g.e[full], g.work[0],
+                     g.V0[full])
+        dx = scene.parts[0].dx
+    gd0, _, e0, _, _ = out["bare"]
+    gd1, q, e1, work, V0 = out["visc"]
+    assert len(q) > 50
+    np.testing.assert_array_equal(gd1[:, 7], gd0[:, 7])          # p: the EOS's alone
+    np.testing.assert_array_equal(e1, e0)
+    VR = math.exp(-3.0 * a * dt)
+    ell = np.cbrt(V0)
+    np.testing.assert_allclose(ell, dx, rtol=1e-12)             # the charge's dx
+    if a < 0:
+        assert np.all(q == 0.0) and work == 0.0
+        np.testing.assert_array_equal(gd1, gd0)
+        return
+    p = gd0[:, 7]
+    rho, trL = 1320.0 / VR, -3.0 * a
+    c = np.sqrt([isentrope_c2(VR, pk) for pk in p])
+    want = rho * ell * (1.5 * ell * trL ** 2 - 0.06 * c * trL)
+    cap = 0.5 * rho * ell ** 2 * (-trL) / dt
+    if a > 1e7:
+        assert np.all(want > cap)
+        np.testing.assert_allclose(q, cap, rtol=1e-12)
+    else:
+        assert np.all(want < cap) and want.min() > 1e7
+        np.testing.assert_allclose(q, want, rtol=1e-6)
+    np.testing.assert_allclose(gd1[:, :6], gd0[:, :6] * ((p + q) / p)[:, None], rtol=1e-12)
+    assert work > 0.0
+
+
+def test_bulk_viscosity_is_booked_and_survives_a_restart_on_another_rank_count(tmp_path):
+    """The detonation with the gas viscosity: the ledger closes with gas_viscous > 0, and
+    a run stopped on 2 ranks and continued on 3 is the 1-rank run bit for bit (the
+    checkpoint keeps each point's last q and the dissipated work)."""
+    args = ["run", "detonation_tube", *SMALL, "--set", VISC, "--set", "time.t_end=1.2e-6"]
+    ref, d = tmp_path / "one", tmp_path / "r"
+    res = run_cli(args + ["--out", str(ref)], ranks=1, timeout=600)
+    assert res.returncode == 0, res.stdout + res.stderr
+    res = run_cli(args + ["--out", str(d), "--stop-after", "40"], ranks=2, timeout=600)
+    assert res.returncode == 0, res.stdout + res.stderr
+    res = run_cli(["run", "--restart", str(d / "checkpoint.h5"), "--quiet"], ranks=3,
+                  timeout=600)
+    assert res.returncode == 0, res.stdout + res.stderr
+    with h5py.File(ref / "run.h5", "r") as f1, h5py.File(d / "run.h5", "r") as f:
+        for k in ("fields/u", "fields/v", "fields/pressure"):
+            assert np.array_equal(f[k][...], f1[k][...]), k
+        e = f1["energy"]
+        assert e["gas_viscous"][-1] > 0.0 and np.all(np.diff(e["gas_viscous"][...]) >= 0.0)
+        assert np.abs(e["balance"][...]).max() < 1e-5
+        np.testing.assert_allclose(f["energy/gas_viscous"][...], e["gas_viscous"][...],
+                                   rtol=1e-12)
+
+
+def test_a_negative_viscosity_coefficient_is_refused():
+    with pytest.raises(sc.SceneError, match="quadratic"):
+        sc.load("detonation_tube", ["materials.explosive.viscosity={quadratic=-1.0}"])
+    with pytest.raises(sc.SceneError, match="lin"):
+        sc.load("detonation_tube", ["materials.explosive.viscosity={lin=0.1}"])
+
+
 def test_the_gas_is_its_own_model_family(team):
     """The explosive is the "ul" model (mpipd.model.gas), built from the scene beside
     the correspondence solids: no material group, history or stress update of the

@@ -14,6 +14,19 @@ For an owned gas point i over its current family (gas and the solids it acts on)
 (p_u: the unreacted explosive's Hugoniot pressure, mpipd.materials.jwl.unreacted_pressure;
 0 without one.)
 
+Bulk viscosity (mpipd.materials.jwl.BulkViscosity; off when both coefficients are 0).
+A point whose volume decreases, tr L_i < 0, carries q_i = rho l (C_q l (tr L)^2 - C_l c tr L)
+(rho = rho0 / V_R, c^2 = lam k c_JWL^2 + (1 - lam) c_u^2, l = V0^(1/3): the point's lattice
+spacing, for its horizon does not grow with it) besides p_i, and its force state is
+A_i = -(p_i + q_i) M_i^-1.  q is a viscosity nu = q / (rho |tr L|), explicit in time, so
+it is held to the diffusion limit nu dt / l^2 <= 1/2: q <= rho l^2 |tr L| / (2 dt) (it
+binds only where C_q |tr L| dt > 1/2, on a point deforming by tens of per cent in a
+step: an escaped point with a sparse family, whose q would otherwise pump energy in).
+The energy equation below takes the work of the p part only; the work of the q part
+(of the same trapezoid, split in proportion p : q, which is exact because the force
+is linear in A) is dissipated and summed into ``work[0]`` as -W_q >= 0 (the ledger's
+``gas_viscous``).
+
 Energy.  The internal energy changes by exactly the trapezoidal work of the
 point's own force state (what the energy ledger books for every force, the
 "compatible" energy update of Owen 2014 for SPH).  Pair weights are the
@@ -42,7 +55,7 @@ import math
 import numba
 import numpy as np
 
-from ..materials.jwl import jwl_cold, unreacted_pressure
+from ..materials.jwl import jwl_cold, jwl_sound_speed2, unreacted_pressure, unreacted_sound_speed2
 from .layout import GD_P, GD_V
 from .linalg import det3, inv3
 
@@ -62,14 +75,18 @@ def current_bond(y, i, j):
 
 @numba.njit(cache=True)
 def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
-               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, K_u=0.0, s_u=0.0, a_u=1.0):
+               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, gq, work, rho0=1.0, c_q=0.0,
+               c_l=0.0, K_u=0.0, s_u=0.0, a_u=1.0):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
     (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
     step's pair weights, so the result does not depend on the update order) and
     ``V_pw`` those of the step before (the last force's weights).  Returns the
     number of gas points with a singular M.  ``vr_lit[k]``: V_R of point k at the
-    step it is first lit (0 until then).  K_u, s_u, a_u: the unreacted EOS
+    step it is first lit (0 until then).  ``gq[i]``: the bulk viscosity q of the last
+    step, replaced by this step's; ``work[0]`` += the dissipated work of q (module
+    docstring); rho0, c_q, c_l: the charge's density and the viscosity's
+    coefficients.  K_u, s_u, a_u: the unreacted EOS
     (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
@@ -122,7 +139,10 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             N[2, 1] += wgt * z2 * y1
             N[2, 2] += wgt * z2 * y2
             nb += 1
-        W_a = wa * V_pw[i] * dt
+        W_a = wa * V_pw[i] * dt                  # of the last force, A^n = -(p^n + q^n) M^-1
+        ptot = gd[i, GD_P] + gq[i]
+        W_aq = W_a * gq[i] / ptot if ptot != 0.0 else 0.0
+        W_a -= W_aq                             # its p part (the energy equation's)
         M[1, 0] = M[0, 1]
         M[2, 0] = M[0, 2]
         M[2, 1] = M[1, 2]
@@ -152,9 +172,21 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         pu = (1.0 - lam) * unreacted_pressure(VR, K_u, s_u, a_u)
         e[k] = ((e[k] * V0[k] - 0.5 * W_a - 0.5 * (lk * f + pu) * bb)
                 / (V0[k] + 0.5 * lk * w * bb / VR))
-        p = (lk * (f + w * e[k] / VR) if lam > 0.0 else 0.0) + pu
+        pj = f + w * e[k] / VR                  # the products' JWL pressure
+        p = (lk * pj if lam > 0.0 else 0.0) + pu
+        q = 0.0
+        if trL < 0.0 and (c_q > 0.0 or c_l > 0.0):
+            c2 = (lk * jwl_sound_speed2(VR, pj, rho0, A, B, R1, R2, w) if lam > 0.0 else 0.0)
+            c2 += (1.0 - lam) * unreacted_sound_speed2(VR, rho0, K_u, s_u, a_u)
+            ell = V0[k] ** (1.0 / 3.0)
+            rho = rho0 / VR
+            q = rho * ell * (c_q * ell * trL * trL - c_l * math.sqrt(max(c2, 0.0)) * trL)
+            q = min(q, -0.5 * rho * ell * ell * trL / dt)     # its explicit limit
+        work[0] -= 0.5 * (W_aq + q * bb)        # -W_q: the work q took out (trapezoid)
+        gq[i] = q
         gd[i, GD_V] = V_new
         gd[i, GD_P] = p
+        p += q                                  # the force state's pressure
         if singular or p == 0.0:
             for c in range(6):
                 gd[i, c] = 0.0

@@ -72,6 +72,53 @@ def unreacted_pressure(VR, K, s, a):
     return K * eta / (q * q)
 
 
+@numba.njit(cache=True, inline="always")
+def jwl_sound_speed2(VR, p, rho0, A, B, R1, R2, w):
+    """Squared sound speed (m^2/s^2) of the products at (VR, p) along their isentrope
+    (module docstring): with p_s(V) = A exp(-R1 V) + B exp(-R2 V) + C V^-(1+w) through
+    (VR, p) and rho = rho0 / V,
+
+        c^2 = dp_s/drho = (VR^2 / rho0) [R1 A e1 + R2 B e2 + (1 + w)(p - A e1 - B e2) / VR],
+
+    e1 = exp(-R1 VR), e2 = exp(-R2 VR)."""
+    e1 = A * math.exp(-R1 * VR)
+    e2 = B * math.exp(-R2 * VR)
+    return VR * VR / rho0 * (R1 * e1 + R2 * e2 + (1.0 + w) * (p - e1 - e2) / VR)
+
+
+@numba.njit(cache=True, inline="always")
+def unreacted_sound_speed2(VR, rho0, K, s, a):
+    """Squared sound speed (m^2/s^2) of the unreacted explosive along its Hugoniot
+    (:func:`unreacted_pressure`): c^2 = -(VR^2 / rho0) dp/dVR = (VR^2 / rho0) a K
+    (1 + s eta) / (1 - s eta)^3 for eta = 1 - a VR > 0, else 0 (the loose bed)."""
+    eta = 1.0 - a * VR
+    if K == 0.0 or eta <= 0.0:
+        return 0.0
+    q = 1.0 - s * eta
+    return VR * VR / rho0 * a * K * (1.0 + s * eta) / (q * q * q)
+
+
+@dataclass(frozen=True)
+class BulkViscosity:
+    """Artificial bulk viscosity of the gas (von Neumann & Richtmyer 1950, with the
+    linear term of Landshoff 1955; the form of Wilkins 1980, J. Comput. Phys. 36,
+    281-303, Eq. 3, and of LS-DYNA's Q1/Q2): a gas point whose volume decreases
+    (tr L < 0) carries, besides its EOS pressure,
+
+        q = rho l (quadratic l (tr L)^2 - linear c tr L),   l = V0^(1/3),
+
+    with rho = rho0 / V_R and c its sound speed (products and unreacted explosive
+    mixed by the burn fraction, :func:`jwl_sound_speed2`, :func:`unreacted_sound_speed2`).
+    q is held to its explicit-time limit (mpipd.kernels.ul).
+    Defaults 1.5 and 0.06 are the hydrocode values (LS-DYNA's Q1, Q2).  Its work is
+    dissipated: the ledger's ``gas_viscous``, not the gas's e (mpipd.kernels.ul)."""
+    quadratic: float = 1.5
+    linear: float = 0.06
+
+    def check(self, path):
+        non_negative(self, path, "quadratic", "linear")
+
+
 @dataclass(frozen=True)
 class Unreacted:
     """The inert explosive before it is lit (:func:`unreacted_pressure`): ``c0`` (m/s)
@@ -156,6 +203,11 @@ class Explosive(JWL):
     but not for a delayed charge beside a fired one, which the rock may squeeze
     before it is lit.  The compression work goes into e, so
     the ledger's ``gas`` books it.
+
+    ``viscosity = { quadratic, linear }``: a bulk viscosity of the gas
+    (:class:`BulkViscosity`) against the local collapse of single gas points that
+    updated-Lagrangian correspondence allows (Behzadinasab & Foster 2020); off by
+    default (the paper's model has none).
     """
     initiation_z: float = 0.0
     direction: float = 1.0
@@ -164,6 +216,7 @@ class Explosive(JWL):
     interacts_with: tuple[str, ...] = ()
     pressure_factor: float = 1.0
     unreacted: Unreacted | None = None
+    viscosity: BulkViscosity | None = None
     tension: None = None
     family = "ul"                       # its points are the updated-Lagrangian gas
 
@@ -179,6 +232,14 @@ class Explosive(JWL):
             if u.solid_density is not None and u.solid_density < self.density:
                 fail(join(join(path, "unreacted"), "solid_density"),
                      f"must be at least the charge's density {self.density:g}")
+        if self.viscosity is not None:
+            self.viscosity.check(join(path, "viscosity"))
+
+    @property
+    def bulk_viscosity(self) -> tuple[float, float]:
+        """(quadratic, linear) of :class:`BulkViscosity`; (0, 0) without one."""
+        q = self.viscosity
+        return (0.0, 0.0) if q is None else (q.quadratic, q.linear)
 
     @property
     def unreacted_eos(self) -> tuple[float, float, float]:

@@ -21,7 +21,9 @@ material.
   the families, volume, energy and pressure on; ``force_data`` hands the halo the
   force data ``gd`` that ``update`` made; ``gather`` adds the pair forces.
 * Kernels: mpipd.kernels.ul.  The gas energy (per initial volume) changes by
-  exactly the trapezoidal work of the gas's forces; it is the ledger's ``gas``.
+  exactly the trapezoidal work of the gas's pressure forces; it is the ledger's
+  ``gas``.  With a bulk viscosity (the material's ``viscosity``), the work of its
+  q is summed in ``viscous_work`` (this rank's share): the ledger's ``gas_viscous``.
 """
 from __future__ import annotations
 
@@ -97,6 +99,10 @@ class Gas(Model):
         self.search_seconds = 0.0
         self.n_singular = 0
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
+        self.c_q, self.c_l = m.bulk_viscosity
+        self.viscous = self.c_q > 0.0 or self.c_l > 0.0
+        self.gq = np.zeros(p.n_local)            # bulk viscosity q of the last step
+        self.work = np.zeros(1)                  # dissipated work of q, this rank (J)
         self.y = None                            # current positions of the last update
 
     def register(self, state):
@@ -126,6 +132,10 @@ class Gas(Model):
         add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
         add("gas_y", own, get=lambda: self.y, rows=AUX)
+        add("gas_q", own, self.gq, rows=LOCAL, checkpoint=self.viscous)
+        if self.viscous:
+            state.scalar("gas_viscous_work", own, lambda: float(self.work[0]),
+                         lambda v: self.work.__setitem__(0, float(v)))
         state.offer("pressure", own, self.pressure)
         # the every-step peak, whole run (a restart goes on from it)
         state.scalar("gas_peak_pressure", own, lambda: self.peak_pressure,
@@ -186,7 +196,7 @@ class Gas(Model):
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, self.vr_lit,
-            *m.unreacted_eos)
+            self.gq, self.work, m.density, self.c_q, self.c_l, *m.unreacted_eos)
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
@@ -221,6 +231,12 @@ class Gas(Model):
             mean = team.sum(float(rho.sum())) / max(n_lit, 1)
             out[name] = {"max": mx, "mean": mean, "lit_fraction": n_lit / n_all}
         return out
+
+    @property
+    def viscous_work(self) -> float:
+        """Work taken out by the gas's bulk viscosity on this rank (J, >= 0 to the
+        trapezoid's accuracy): the ledger's ``gas_viscous``."""
+        return float(self.work[0])
 
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""

@@ -26,6 +26,8 @@ Terms (J, global sums over the owned points of every rank)::
                 viscous      minus the work of the artificial viscosity (trapezoid)
                 damping      removed by the damping of phi = 1 points (Eq. 41)
                 gas_damping  removed by the gas damping (§2.6)
+                gas_viscous  taken out by the gas's bulk viscosity q (mpipd.kernels.ul:
+                             the trapezoidal work of its part of the gas force)
                 absorbed     taken out by absorbing layers (mpipd.input.loads.Absorbing):
                              the damping work of the points in a layer (a layer point
                              that fails books its Eq. 41 damping here too)
@@ -47,14 +49,15 @@ Terms (J, global sums over the owned points of every rank)::
 Every force the step applies is in exactly one of these: the correspondence
 force (its work is the stress work W, to O(dt^2)), hourglass, spring and
 contact (potentials), gas (its work leaves e by the trapezoidal energy
-equation), viscosity, damping, interface (their work), loads (external).
+equation), viscosity, gas viscosity, damping, interface (their work), loads
+(external).
 So |balance| is the time-discretisation error, of order (omega dt)^2, plus
 one-step errors where forces switch (a failure, a break): a term left out
 shows as a balance of its own size.
 
 Impossible values are errors: a held term that must be >= 0 below -tol
 (kinetic, elastic, hourglass, spring, contact, gas) or a dissipation below
--tol (plastic, removed, viscous, damping, gas_damping), tol = BALANCE_TOL x
+-tol (plastic, removed, viscous, damping, gas_damping, gas_viscous, absorbed), tol = BALANCE_TOL x
 scale, are listed by :func:`impossible`.
 """
 from __future__ import annotations
@@ -69,12 +72,12 @@ from ..state import AUX, LAST
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
-              "absorbed", "interface", "multirate")
+              "gas_viscous", "absorbed", "interface", "multirate")
 #: the datasets of /energy in a run file, in this order
 TERMS = ("t",) + HELD + DISSIPATED + ("external", "initial", "balance")
 #: terms that cannot be negative (beyond round-off and O(dt^2) noise)
 NON_NEGATIVE = ("kinetic", "elastic", "hourglass", "spring", "contact", "gas", "plastic",
-                "removed", "viscous", "damping", "gas_damping", "absorbed")
+                "removed", "viscous", "damping", "gas_damping", "gas_viscous", "absorbed")
 #: |balance| and the negative excursions that :func:`impossible` tolerates
 BALANCE_TOL = 1e-3
 
@@ -95,6 +98,7 @@ class Energies:
     viscous: float = 0.0
     damping: float = 0.0
     gas_damping: float = 0.0
+    gas_viscous: float = 0.0
     absorbed: float = 0.0
     interface: float = 0.0
     multirate: float = 0.0
@@ -128,7 +132,7 @@ class Energies:
     @classmethod
     def from_record(cls, group, frame: int = -1) -> "Energies":
         """The reading of one frame of a run file's ``/energy`` group (h5py); a term
-        the file predates (``multirate``, ``absorbed``) reads 0."""
+        the file predates (``multirate``, ``absorbed``, ``gas_viscous``) reads 0."""
         return cls(**{f.name: float(group[f.name][frame]) if f.name in group else 0.0
                       for f in fields(cls)})
 
@@ -233,6 +237,7 @@ class Ledger:
         removed = float(np.dot(vol[gone], c.W[gone])) + self.jumps
         pot = c.potentials(self.rows, sim.u).sum(axis=0)
         gas = sim.gas.energy() if sim.gas is not None else 0.0
+        gas_viscous = sim.gas.viscous_work if sim.gas is not None else 0.0
         damping = gas_damping = absorbed = 0.0
         if len(self.edamp):
             ed = m * self.edamp
@@ -241,7 +246,8 @@ class Ledger:
             absorbed = float(ed[self.layer].sum())
             damping = float(ed.sum()) - gas_damping - absorbed
         return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, plastic, removed,
-                         self.contact_jumps, -self.viscous_work, damping, gas_damping, absorbed,
+                         self.contact_jumps, -self.viscous_work, damping, gas_damping,
+                         gas_viscous, absorbed,
                          -self.interface_work, self.reclass, sim.external_work])
 
     def read(self, sim) -> Energies:
