@@ -231,6 +231,11 @@ def check_report(scene, ranks: int) -> str:
                 f"(K = {mat.unreacted_eos[0] / 1e9:.3g} GPa)" if u is not None else
                 "no pressure (no unreacted EOS: a charge lit late beside a fired one is "
                 "compressed freely)"))
+            cq, cl = mat.bulk_viscosity
+            out.append("    bulk viscosity: " + (
+                f"q = rho dx ({cq:g} dx (tr L)^2 - {cl:g} c tr L) in compression, at most "
+                f"rho dx^2 |tr L| / (2 dt); its work is the ledger's gas_viscous"
+                if cq > 0 or cl > 0 else "none (a single gas point may collapse: README)"))
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")
