@@ -5,9 +5,14 @@ judges a bench blast by, for one or several runs side by side (the delay cases o
 * **fragmentation**: the fragments of the last frame (postprocess.fragment_report):
   X20, X50, X80 (sieve size), the Rosin–Rammler uniformity n and the Swebrec b,
   the fines and the largest fragment as mass fractions;
-* **overbreak**: how far damage reaches behind the row of holes, away from the
-  free face: the largest y - y_row of a rock point with damage >= 0.5 (or failed),
-  and the damaged fraction of the rock behind the row;
+* **overbreak**: how far damage reaches behind the row of holes, normal to the
+  free face (d = y - y_row).  The rock between the outer holes is cut into 1-dx
+  bins of d; the **overbreak depth** is the outer edge of the unbroken run of bins,
+  from the row back, in each of which at least OVERBREAK_FRACTION (10 %) of the
+  points are damaged (damage >= 0.5, or failed): the zone that the row broke as a
+  whole, which a stray damaged point far back does not move.  Also given: the
+  profile (damaged fraction per bin), the farthest damaged point, and the
+  damaged fraction of all the rock behind the row;
 * **vibration**: PPV against the distance d = y - y_row behind the row, from the
   running-peak speed field ``peak_speed`` (a peak over every step): per 1-dx bin
   of d, the largest peak speed among the rock points between the outer holes; and
@@ -39,6 +44,24 @@ from .model import split_scene_text
 from .reader import Run, RunFileError
 
 DAMAGED = 0.5
+#: least damaged fraction of a 1-dx bin behind the row that still counts as overbreak
+OVERBREAK_FRACTION = 0.1
+
+
+def overbreak_depth(fraction: np.ndarray, counts: np.ndarray, dx: float,
+                    start: int = 0) -> float:
+    """Outer edge (m, from the row) of the unbroken run of bins from bin ``start`` on
+    whose damaged ``fraction`` is at least OVERBREAK_FRACTION (bins without points
+    are passed over; 0 if the first bin with points is below it)."""
+    k = start
+    last = start
+    while k < len(fraction):
+        if counts[k] > 0:
+            if fraction[k] < OVERBREAK_FRACTION:
+                break
+            last = k + 1
+        k += 1
+    return last * dx
 
 
 def _rock_box(scene):
@@ -81,6 +104,9 @@ def bench_metrics(path, comm) -> dict:
         band = behind & (x[:, 0] >= min(xs)) & (x[:, 0] <= max(xs))
         nb = int(math.ceil((rock.shape.hi[1] - y_row) / dx)) + 1
         idx = np.clip(np.floor(d / dx).astype(int), 0, nb - 1)
+        n_bin = run.sum_array(np.bincount(idx[band], minlength=nb).astype(np.int64))
+        n_dmg = run.sum_array(np.bincount(idx[band & hit], minlength=nb).astype(np.int64))
+        frac = n_dmg / np.maximum(n_bin, 1)
         top = np.zeros(nb)
         np.maximum.at(top, idx[band], ppv[band])
         top = run.max_array(top)
@@ -105,7 +131,12 @@ def bench_metrics(path, comm) -> dict:
             "peak_gas_pressure_GPa": None if peak_gas is None else float(peak_gas) / 1e9,
             "density_at_lighting_max": (max(v["max"] for v in lit.values()) if lit else None),
             "burden_mm": (y_row - rock.shape.lo[1]) * 1e3,
-            "overbreak_mm": depth * 1e3, "damaged_fraction_behind": n_hit / max(n_behind, 1),
+            "overbreak_mm": overbreak_depth(frac, n_bin, dx, int(r_hole // dx)) * 1e3,
+            "overbreak_profile": {"d_mm": (np.arange(nb) * dx * 1e3).tolist(),
+                                  "damaged_fraction": frac.tolist(),
+                                  "points": np.asarray(n_bin).tolist()},
+            "farthest_damaged_mm": depth * 1e3,
+            "damaged_fraction_behind": n_hit / max(n_behind, 1),
             "ppv_d_mm": (centres * 1e3).tolist(), "ppv_m_s": top.tolist(), "ppv_fit": fit}
 
 
@@ -148,7 +179,10 @@ def _table(rows, runs) -> str:
              "{:.2f}"),
             ("largest fragment, % of the mass",
              lambda r: _pct(_get(r, "fragments", "largest_mass_fraction")), "{:.1f}"),
-            ("overbreak behind the row (mm)", lambda r: r["overbreak_mm"], "{:.3g}"),
+            ("overbreak depth behind the row (mm; >= 10 % of each 1-dx bin damaged)",
+             lambda r: r["overbreak_mm"], "{:.3g}"),
+            ("farthest damaged point behind the row (mm)",
+             lambda r: r.get("farthest_damaged_mm"), "{:.3g}"),
             ("damaged fraction of the rock behind the row",
              lambda r: r["damaged_fraction_behind"], "{:.3f}"),
             ("PPV fit K (m/s at 1 m: K d^-beta)", lambda r: _get(r, "ppv_fit", "K"), "{:.3g}"),

@@ -99,7 +99,10 @@ def test_bench_summary_side_by_side(first_microsecond, tmp_path):
     # at 0.6 us the three lit holes have moved the rock behind the row more than one
     assert max(doc["sim"]["ppv_m_s"]) > max(doc["long"]["ppv_m_s"]) > 0
     assert (tmp_path / "b" / "sim" / "fragments.csv").exists()
-    assert "| overbreak behind the row (mm) |" in (tmp_path / "b" / "bench.md").read_text()
+    assert "| overbreak depth behind the row" in (tmp_path / "b" / "bench.md").read_text()
+    prof = doc["sim"]["overbreak_profile"]
+    assert len(prof["d_mm"]) == len(prof["damaged_fraction"]) == len(prof["points"])
+    assert doc["sim"]["overbreak_mm"] <= doc["sim"]["farthest_damaged_mm"] + 1.0
     # the absorbing layer (y > 50 mm, d > 35 mm behind the row) is not rock the blast sees
     d, v = np.array(doc["sim"]["ppv_d_mm"]), np.array(doc["sim"]["ppv_m_s"])
     assert d.max() > 50.0 and np.all(v[d > 35.0] == 0.0) and v[d < 35.0].max() > 0
@@ -107,3 +110,19 @@ def test_bench_summary_side_by_side(first_microsecond, tmp_path):
     # few per cent before they are lit (measured 1.034 here, 1.062 by 36 µs), no more
     assert 1.0 <= doc["sim"]["density_at_lighting_max"] < 1.1
     assert doc["sim"]["peak_gas_pressure_GPa"] > 1.0
+
+
+def test_overbreak_depth_is_the_unbroken_damaged_run_from_the_row():
+    """Bins of 1 mm behind the row: 50, 30, 12 % damaged, an empty bin (passed over),
+    then 5 % and a stray 50 % far back: the depth is the edge of the 12 % bin (4 mm),
+    not the stray bin's; a first bin below 10 % gives the start; an all-damaged
+    profile gives its last bin's edge."""
+    from postprocess.bench import OVERBREAK_FRACTION, overbreak_depth
+    assert OVERBREAK_FRACTION == 0.1
+    frac = np.array([0.0, 0.5, 0.3, 0.12, 0.0, 0.05, 0.5])
+    n = np.array([0, 10, 10, 25, 0, 20, 10])
+    assert overbreak_depth(frac, n, 1e-3) == pytest.approx(4e-3)
+    assert overbreak_depth(frac, n, 1e-3, start=1) == pytest.approx(4e-3)
+    assert overbreak_depth(np.array([0.05, 0.9]), np.array([20, 20]), 1e-3) == 0.0
+    assert overbreak_depth(np.array([0.0, 0.2, 0.2]), np.array([0, 5, 5]), 2e-3,
+                           start=1) == pytest.approx(6e-3)

@@ -101,9 +101,10 @@ def fracture_runs(tmp_path_factory):
 
 
 def test_fracture_identical_on_1_2_3_ranks(fracture_runs):
-    """Same failed set, same broken bonds, bit-identical fields (3 ranks: multi-hop halo)."""
+    """Same failed set, same broken bonds (the run file's /bonds, every frame's broken
+    gid pairs), bit-identical fields (3 ranks: multi-hop halo)."""
     keys = ("fields/u", "fields/v", "fields/damage", "fields/failure_mode", "fields/jh2_damage",
-            "fields/pressure") + tuple(f"probes/{p}/{q}" for p in ("near", "far")
+            "fields/pressure", "bonds/broken", "bonds/offsets") + tuple(f"probes/{p}/{q}" for p in ("near", "far")
                                        for q in ("t", "sigma_rr", "v_r", "p", "s", "strength"))
     with h5py.File(fracture_runs[1], "r") as f1:
         ref = {k: f1[k][...] for k in keys}
@@ -144,7 +145,8 @@ def rockmass_runs(tmp_path_factory):
 
 def test_rockmass_identical_on_1_2_3_ranks(rockmass_runs, fracture_runs):
     keys = ("geometry/x", "geometry/strength_factor", "fields/u", "fields/v", "fields/damage",
-            "fields/failure_mode", "probes/near/sigma_rr", "probes/near/strength")
+            "fields/failure_mode", "probes/near/sigma_rr", "probes/near/strength",
+            "bonds/broken", "bonds/offsets")
     with h5py.File(rockmass_runs[1], "r") as f1:
         ref = {k: f1[k][...] for k in keys}
         broken, joint = f1.attrs["bonds_broken"], f1.attrs["joint_bonds"]
