@@ -10,7 +10,12 @@
 
 # blast_paper_mr4 / _graded_mr4 / _dx1.2_mr4: mpirun -n 2 mpipd run blast_paper[:graded or :dx1.2] --set 'time.multirate={max_ratio=4,safety=0.5}'
 #   --set output.every=200 --set output.checkpoint_every=400 (500 for dx1.2) --out runs/blast_paper[_graded or _dx1.2]_mr4
-VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
+#   (blast_paper steps at ratio 4 by default since 8850a06: the --set multirate is now the scene's own)
+# blast_paper_dx1.2_rockmass_mr4 (b820a4a): mpirun -n 2 mpipd run blast_paper:rockmass --set parts.2.dx=1.2e-3
+#   --set 'scene.name="blast_paper-dx1.2-rockmass"' --set 'time.multirate={max_ratio=4,safety=0.5}'
+#   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_dx1.2_rockmass_mr4
+VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
+    runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
 VALIDATE_RANKS ?= 2
