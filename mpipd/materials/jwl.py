@@ -204,10 +204,10 @@ class Explosive(JWL):
     before it is lit.  The compression work goes into e, so
     the ledger's ``gas`` books it.
 
-    ``viscosity = { quadratic, linear }``: a bulk viscosity of the gas
-    (:class:`BulkViscosity`) against the local collapse of single gas points that
-    updated-Lagrangian correspondence allows (Behzadinasab & Foster 2020); off by
-    default (the paper's model has none).
+    ``viscosity = { quadratic, linear }``: a shock (bulk) viscosity of the gas
+    (:class:`BulkViscosity`); off by default (the paper's model has none).  It
+    does not keep gas points out of the solids they act on (README, the delay
+    study: the spikes of the delayed cases are gas passing into a tube).
     """
     initiation_z: float = 0.0
     direction: float = 1.0
