@@ -235,7 +235,7 @@ def check_report(scene, ranks: int) -> str:
             out.append("    bulk viscosity: " + (
                 f"q = rho dx ({cq:g} dx (tr L)^2 - {cl:g} c tr L) in compression, at most "
                 f"rho dx^2 |tr L| / (2 dt); its work is the ledger's gas_viscous"
-                if cq > 0 or cl > 0 else "none (a single gas point may collapse: README)"))
+                if cq > 0 or cl > 0 else "none"))
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")
