@@ -143,7 +143,8 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
                               "requested_part": p.get("requested_part"),
                               "snap_distance_mm": p["snap_distance_mm"], "error": p["error"]}
                           for n, p in probes.items()}}
-    metrics.update({k: vol[k] for k in ("energy", "failure_modes", "frame_series")})
+    metrics.update({k: vol[k] for k in ("energy", "failure_modes", "frame_series",
+                                         "gas_containment")})
     metrics.update(peaks.scan(run, model, probes))
     metrics["explosive_reference"] = explosive.reference(model, metrics["gas_pressure"],
                                                          metrics["wall_radial_stress"])

@@ -4,7 +4,8 @@ an ``{"error": ...}`` in its own block and is never shown as a number.
 
 Collected: a probe whose point is not in its part (:mod:`postprocess.probe_metrics`),
 first-arrival times that do not increase with distance (:mod:`postprocess.arrivals`),
-a negative energy in the rock (:mod:`postprocess.volume`), a negative ledger term
+a negative energy in the rock and explosive points inside the rock
+(:mod:`postprocess.volume`), a negative ledger term
 that must be non-negative (:mod:`postprocess.ledger`), and any other measure that
 came out as an error.
 """
@@ -21,6 +22,8 @@ def collect(m: dict, probes: dict) -> list[dict]:
         out.append({"measure": "wave speed (first arrivals)", "message": ws["error"]})
     if "error" in m["energy"]:
         out.append({"measure": "energy in the rock (Fig. 20)", "message": m["energy"]["error"]})
+    if "error" in m.get("gas_containment", {}):
+        out.append({"measure": "gas containment", "message": m["gas_containment"]["error"]})
     out += m["energy_ledger"].get("errors", [])
     for key in ("gas_pressure", "wall_radial_stress", "wall_pressure"):
         if "error" in m[key] and not m[key]["error"].startswith("wall probe"):

@@ -70,6 +70,7 @@ class Model:
     explosive: object = None                     # the charge's JWL material (or None)
     peak_center: tuple = (0.0, 0.0)              # axis of the peak_sigma_rr field
     part_material: dict = field(default_factory=dict)   # part index -> material name
+    explosive_materials: tuple = ()              # names of the jwl materials (the gas)
     probe_parts: dict = field(default_factory=dict)     # probe name -> its scene ``part``
     overrides: list = field(default_factory=list)
     notes: list = field(default_factory=list)
@@ -224,6 +225,8 @@ def load_model(run, label: str | None = None) -> Model:
             zone_dx[k] = float(np.cbrt(run.max(float(v.max()) if len(v) else 0.0)))
             zone_horizon[k] = 3.0 * zone_dx[k]
     density, jh2, pf, explosive, probe_parts = {}, None, None, None, {}
+    explosives = (tuple(n for n, m in scene.materials.items() if m.registry_name == "jwl")
+                  if scene is not None else ("explosive",))
     peak_center = (0.0, 0.0)
     if scene is not None:
         peak_center = tuple(float(c) for c in getattr(scene.output, "peak_center", (0.0, 0.0)))
@@ -244,5 +247,6 @@ def load_model(run, label: str | None = None) -> Model:
                  pressure_factor=pf, horizon=float(horizon), overrides=sets, notes=notes,
                  rock_ids=rock_ids, zone_dx=zone_dx, zone_horizon=zone_horizon,
                  wall_dx=float(wall_dx), explosive=explosive,
-                 peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts)
+                 peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts,
+                 explosive_materials=explosives)
 

@@ -17,6 +17,12 @@ rank reads one frame of one field of its own slice at a time).
   along the borehole).
 * Failure modes (Fig. 13): rock points per failure_mode at the last frame
   (0 intact, 1 JH2 plastic, 2 JH2 tensile, 3 tension model).
+* Gas containment, per frame, from the ``u`` field: the explosive's points whose
+  current position lies inside the rock, R_b + wall_dx/2 < r < R_o and z0 < z < z1
+  (more than half a rock spacing beyond the borehole wall, within the specimen).
+  The gas cannot be there: a point inside the rock has passed through the tube and
+  the wall, which its pressure state alone does not prevent.  Any such point makes
+  the block an error naming the largest count and fraction of the charge.
 """
 from __future__ import annotations
 
@@ -51,8 +57,19 @@ def scan(run, model, profile_frames) -> dict:
     has_s = run.has_field("stress")
     iw = np.flatnonzero(wall)
     gas_p = np.full(nf, -np.inf)
+    gas = np.isin(mat, [m for m, name in enumerate(model.material_names)
+                        if name in model.explosive_materials])
+    has_u = run.has_field("u") and bool(run.sum_int(int(gas.sum())))
+    ig = np.flatnonzero(gas)
+    in_rock = np.zeros(nf, np.int64)
     prof = {}
     for k in range(nf):
+        if has_u and len(ig):
+            y = x[ig] + run.field("u", k, span=(int(ig[0]), int(ig[-1]) + 1))[ig - ig[0]]
+            ry = model.radius(y)
+            in_rock[k] = int(np.count_nonzero(
+                (ry > model.r_wall + 0.5 * model.wall_dx) & (ry < model.r_out)
+                & (y[:, 2] > model.z0) & (y[:, 2] < model.z1)))
         if has_v and rock_rho_known:
             v = run.field("v", k)
             ek[:, k] = run.per_level(np.where(rock, 0.5 * vol * rho * (v ** 2).sum(1), 0.0))
@@ -100,6 +117,22 @@ def scan(run, model, profile_frames) -> dict:
                                         "z_mm": (lev_z[ok] * 1e3).tolist(),
                                         "p_MPa": (a[ok, 0] / a[ok, 1] / 1e6).tolist()})
     out["failure_modes"] = _failure_modes(run, rock)
+    out["gas_containment"] = (_containment(run.sum_array(in_rock), run.sum_int(int(gas.sum())),
+                                           run.time)
+                              if has_u else {"not_available": "no u field or no explosive"})
+    return out
+
+
+def _containment(in_rock: np.ndarray, n_gas: int, times) -> dict:
+    """Per frame, the explosive's points inside the rock (module docstring)."""
+    k = int(np.argmax(in_rock))
+    out = {"t_us": [float(t) * 1e6 for t in times], "points_in_rock": in_rock.tolist(),
+           "charge_points": int(n_gas), "max_fraction": float(in_rock[k]) / max(n_gas, 1),
+           "max_at_us": float(times[k]) * 1e6}
+    if in_rock[k] > 0:
+        out["error"] = (f"{int(in_rock[k])} explosive points ({100 * out['max_fraction']:.3g} % "
+                        f"of the charge) inside the rock at {out['max_at_us']:.3g} us: the gas "
+                        "passed through the tube and the borehole wall")
     return out
 
 

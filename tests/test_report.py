@@ -300,6 +300,41 @@ def test_sections_of_a_graded_rock_span_every_zone(tmp_path):
         assert sec["radial_cracks"]["count"] == 1
 
 
+def test_gas_inside_the_rock_is_an_error(tmp_path):
+    """Explosive points moved (u field) at frame 2: 7 to r = 10 mm inside the specimen,
+    2 to r = R_b + 0.4 dx (still at the wall), 3 beyond R_o and 4 past the far face:
+    only the 7 are inside the rock, an error naming 7 points; at rest, none."""
+    x, part = write_run(tmp_path / "run.h5")
+    charge = np.flatnonzero(part == 0)
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/u"] = np.zeros((5, len(x), 3))
+    m, _ = analyse(tmp_path / "run.h5")
+    g = m["gas_containment"]
+    assert "error" not in g and g["max_fraction"] == 0.0 and g["charge_points"] == len(charge)
+    assert not any(e["measure"] == "gas containment" for e in m["errors"])
+
+    def to(idx, r, z=None):
+        y = x[idx].copy()
+        y[:, 0], y[:, 1] = r, 0.0
+        if z is not None:
+            y[:, 2] = z
+        return y - x[idx]
+    u = np.zeros((5, len(x), 3))
+    a, b, c, d = charge[:7], charge[7:9], charge[9:12], charge[12:16]
+    u[2, a] = to(a, 10e-3)
+    u[2, b] = to(b, R_WALL + 0.4 * DX)
+    u[2, c] = to(c, R_OUT + 1e-3)
+    u[2, d] = to(d, 10e-3, z=NZ * DX + 1e-3)
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/u"][...] = u
+    m, _ = analyse(tmp_path / "run.h5")
+    g = m["gas_containment"]
+    assert g["points_in_rock"] == [0, 0, 7, 0, 0]
+    assert g["max_fraction"] == pytest.approx(7 / len(charge))
+    assert "7 explosive points" in g["error"]
+    assert any(e["measure"] == "gas containment" for e in m["errors"])
+
+
 def test_radial_cracks_and_crushed_zone(tmp_path):
     """Six rays from the wall to the boundary (0, 60, ... 300 deg), a short ray at 30 deg,
     a chip at the boundary at 150 deg not connected inward, and a crushed disc r < 6 mm:
