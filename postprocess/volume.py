@@ -19,10 +19,13 @@ rank reads one frame of one field of its own slice at a time).
   (0 intact, 1 JH2 plastic, 2 JH2 tensile, 3 tension model).
 * Gas containment, per frame, from the ``u`` field: the explosive's points whose
   current position lies inside the rock, R_b + wall_dx/2 < r < R_o and z0 < z < z1
-  (more than half a rock spacing beyond the borehole wall, within the specimen).
-  The gas cannot be there: a point inside the rock has passed through the tube and
-  the wall, which its pressure state alone does not prevent.  Any such point makes
-  the block an error naming the largest count and fraction of the charge.
+  (more than half a rock spacing beyond the borehole wall, within the specimen),
+  and of those the ones **inside intact rock**: their nearest rock point (current
+  positions) is within sqrt(3)/2 of its dx, a lattice cell's half-diagonal, and has
+  damage < 0.5.  Gas may enter the rock through its cracks and crushed zone, but not
+  intact rock: there it has passed through the tube and the wall, which its pressure
+  state alone does not prevent.  Any point in intact rock makes the block an error
+  naming the largest count and fraction of the charge.
 """
 from __future__ import annotations
 
@@ -62,14 +65,16 @@ def scan(run, model, profile_frames) -> dict:
     has_u = run.has_field("u") and bool(run.sum_int(int(gas.sum())))
     ig = np.flatnonzero(gas)
     in_rock = np.zeros(nf, np.int64)
+    in_intact = np.zeros(nf, np.int64)
+    zdx = np.zeros(int(pid.max()) + 1 if len(pid) else 1)
+    for q in model.zone_ids:
+        if q < len(zdx):
+            zdx[q] = model.dx_of(q)
+    h_rock = zdx[pid[rock]]
     prof = {}
     for k in range(nf):
-        if has_u and len(ig):
-            y = x[ig] + run.field("u", k, span=(int(ig[0]), int(ig[-1]) + 1))[ig - ig[0]]
-            ry = model.radius(y)
-            in_rock[k] = int(np.count_nonzero(
-                (ry > model.r_wall + 0.5 * model.wall_dx) & (ry < model.r_out)
-                & (y[:, 2] > model.z0) & (y[:, 2] < model.z1)))
+        if has_u:
+            in_rock[k], in_intact[k] = _gas_in_rock(run, model, x, ig, rock, h_rock, k)
         if has_v and rock_rho_known:
             v = run.field("v", k)
             ek[:, k] = run.per_level(np.where(rock, 0.5 * vol * rho * (v ** 2).sum(1), 0.0))
@@ -117,22 +122,55 @@ def scan(run, model, profile_frames) -> dict:
                                         "z_mm": (lev_z[ok] * 1e3).tolist(),
                                         "p_MPa": (a[ok, 0] / a[ok, 1] / 1e6).tolist()})
     out["failure_modes"] = _failure_modes(run, rock)
-    out["gas_containment"] = (_containment(run.sum_array(in_rock), run.sum_int(int(gas.sum())),
+    out["gas_containment"] = (_containment(in_rock, in_intact, run.sum_int(int(gas.sum())),
                                            run.time)
                               if has_u else {"not_available": "no u field or no explosive"})
     return out
 
 
-def _containment(in_rock: np.ndarray, n_gas: int, times) -> dict:
-    """Per frame, the explosive's points inside the rock (module docstring)."""
-    k = int(np.argmax(in_rock))
+def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
+    """Frame k: the explosive's points inside the rock's volume, and inside intact rock
+    (module docstring); collective (every rank gets both counts)."""
+    from scipy.spatial import cKDTree
+    y = (x[ig] + run.field("u", k, span=(int(ig[0]), int(ig[-1]) + 1))[ig - ig[0]]
+         if len(ig) else np.zeros((0, 3)))
+    y = np.concatenate(run.comm.allgather(y))           # every gas point, on every rank
+    ry = model.radius(y)
+    inside = ((ry > model.r_wall + 0.5 * model.wall_dx) & (ry < model.r_out)
+              & (y[:, 2] > model.z0) & (y[:, 2] < model.z1))
+    yi = y[inside]
+    ir = np.flatnonzero(rock)
+    near = np.full(len(yi), np.inf)                     # distance / (sqrt(3)/2 h) of the
+    intact = np.zeros(len(yi), bool)                    # nearest local rock point
+    if len(ir) and len(yi):
+        span = (int(ir[0]), int(ir[-1]) + 1)
+        yr = x[ir] + run.field("u", k, span=span)[ir - ir[0]]
+        d, j = cKDTree(yr).query(yi)
+        near = d / (0.5 * np.sqrt(3.0) * h_rock[j])
+        dmg = run.field("damage", k, span=span)[ir - ir[0]] if run.has_field("damage") else None
+        intact = np.ones(len(yi), bool) if dmg is None else dmg[j] < 0.5
+    # the nearest rock point over all ranks decides (ties: the lower rank)
+    allnear = np.array(run.comm.allgather(near)).reshape(run.comm.Get_size(), -1)
+    allint = np.array(run.comm.allgather(intact)).reshape(run.comm.Get_size(), -1)
+    best = np.argmin(allnear, axis=0) if len(yi) else np.zeros(0, int)
+    cols = np.arange(len(yi))
+    hit = (allnear[best, cols] < 1.0) & allint[best, cols]
+    return int(inside.sum()), int(np.count_nonzero(hit))
+
+
+def _containment(in_rock: np.ndarray, in_intact: np.ndarray, n_gas: int, times) -> dict:
+    """Per frame, the explosive's points inside the rock and inside intact rock."""
+    k = int(np.argmax(in_intact))
     out = {"t_us": [float(t) * 1e6 for t in times], "points_in_rock": in_rock.tolist(),
-           "charge_points": int(n_gas), "max_fraction": float(in_rock[k]) / max(n_gas, 1),
+           "points_in_intact_rock": in_intact.tolist(), "charge_points": int(n_gas),
+           "max_fraction_in_rock": float(in_rock.max()) / max(n_gas, 1),
+           "max_fraction_in_intact_rock": float(in_intact[k]) / max(n_gas, 1),
            "max_at_us": float(times[k]) * 1e6}
-    if in_rock[k] > 0:
-        out["error"] = (f"{int(in_rock[k])} explosive points ({100 * out['max_fraction']:.3g} % "
-                        f"of the charge) inside the rock at {out['max_at_us']:.3g} us: the gas "
-                        "passed through the tube and the borehole wall")
+    if in_intact[k] > 0:
+        out["error"] = (f"{int(in_intact[k])} explosive points "
+                        f"({100 * out['max_fraction_in_intact_rock']:.3g} % of the charge) "
+                        f"inside intact rock at {out['max_at_us']:.3g} us: the gas passed "
+                        "through the tube and the borehole wall")
     return out
 
 

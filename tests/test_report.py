@@ -300,18 +300,29 @@ def test_sections_of_a_graded_rock_span_every_zone(tmp_path):
         assert sec["radial_cracks"]["count"] == 1
 
 
-def test_gas_inside_the_rock_is_an_error(tmp_path):
-    """Explosive points moved (u field) at frame 2: 7 to r = 10 mm inside the specimen,
-    2 to r = R_b + 0.4 dx (still at the wall), 3 beyond R_o and 4 past the far face:
-    only the 7 are inside the rock, an error naming 7 points; at rest, none."""
-    x, part = write_run(tmp_path / "run.h5")
+def test_gas_inside_intact_rock_is_an_error(tmp_path):
+    """Explosive points moved (u field) at frame 4 (the last; damage = 1 on the failed
+    mask there): 7 onto intact rock points at r ~ 10 mm (+0.3 dx off them), 5 onto
+    failed rock points (a crack: gas may be there), 2 to r = R_b + 0.4 dx (still at the
+    wall), 3 beyond R_o and 4 past the far face.  In the rock's volume: 12; inside
+    intact rock: 7, an error naming 7 points.  At rest: none."""
+    xs, part = lattice()
+    rockpts = np.flatnonzero((part == 1) & (np.abs(np.hypot(xs[:, 0], xs[:, 1]) - 10e-3) < DX))
+    crack = rockpts[::3][:5]
+    failed = np.zeros(len(xs), bool)
+    failed[crack] = True
+    x, part = write_run(tmp_path / "run.h5", failed=failed)
     charge = np.flatnonzero(part == 0)
     with h5py.File(tmp_path / "run.h5", "r+") as f:
         f["fields/u"] = np.zeros((5, len(x), 3))
     m, _ = analyse(tmp_path / "run.h5")
     g = m["gas_containment"]
-    assert "error" not in g and g["max_fraction"] == 0.0 and g["charge_points"] == len(charge)
+    assert "error" not in g and g["points_in_intact_rock"] == [0] * 5
+    assert g["charge_points"] == len(charge)
     assert not any(e["measure"] == "gas containment" for e in m["errors"])
+
+    def onto(idx, targets, off=0.3 * DX):
+        return x[targets] + np.array([off, 0.0, 0.0]) - x[idx]
 
     def to(idx, r, z=None):
         y = x[idx].copy()
@@ -319,18 +330,21 @@ def test_gas_inside_the_rock_is_an_error(tmp_path):
         if z is not None:
             y[:, 2] = z
         return y - x[idx]
+    intact = [t for t in rockpts[1::3] if not failed[t]][:7]
     u = np.zeros((5, len(x), 3))
-    a, b, c, d = charge[:7], charge[7:9], charge[9:12], charge[12:16]
-    u[2, a] = to(a, 10e-3)
-    u[2, b] = to(b, R_WALL + 0.4 * DX)
-    u[2, c] = to(c, R_OUT + 1e-3)
-    u[2, d] = to(d, 10e-3, z=NZ * DX + 1e-3)
+    a, b, c, d, e = charge[:7], charge[7:12], charge[12:14], charge[14:17], charge[17:21]
+    u[4, a] = onto(a, intact)
+    u[4, b] = onto(b, crack)
+    u[4, c] = to(c, R_WALL + 0.4 * DX)
+    u[4, d] = to(d, R_OUT + 1e-3)
+    u[4, e] = to(e, 10e-3, z=NZ * DX + 1e-3)
     with h5py.File(tmp_path / "run.h5", "r+") as f:
         f["fields/u"][...] = u
     m, _ = analyse(tmp_path / "run.h5")
     g = m["gas_containment"]
-    assert g["points_in_rock"] == [0, 0, 7, 0, 0]
-    assert g["max_fraction"] == pytest.approx(7 / len(charge))
+    assert g["points_in_rock"] == [0, 0, 0, 0, 12]
+    assert g["points_in_intact_rock"] == [0, 0, 0, 0, 7]
+    assert g["max_fraction_in_intact_rock"] == pytest.approx(7 / len(charge))
     assert "7 explosive points" in g["error"]
     assert any(e["measure"] == "gas containment" for e in m["errors"])
 
