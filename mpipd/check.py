@@ -57,7 +57,8 @@ JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
 GAS_LOCAL, GAS_OWNED = 90, 32   # gas force data (8), flags, gas horizon, pair weights (2 steps);
 #                                 UL offsets, V ratio, damping, the ledger's damping energy
 PEAKS_OWNED = 24                # peak_pressure, peak_sigma_rr, peak_speed (if asked for)
-BYTES_PER_GAS_POINT = 40        # index, V0, e, lighting time, not-TL index
+BYTES_PER_GAS_POINT = 56        # index, V0, e, lighting time, not-TL index, density at
+#                                 lighting, last bulk q
 BYTES_PER_UL_POINT = 16         # the UL search lists (eligible, rows): the gas and the
 #                                 points of its interacts_with solids, on every rank
 

@@ -75,6 +75,21 @@ def run_cli(args, ranks=None, timeout=300, cwd=None):
                           env=child_env())
 
 
+def restart_matches(checkpoint, reference, keys, ranks, timeout=300) -> Path:
+    """Continue ``checkpoint`` with ``mpipd run --restart`` on ``ranks`` ranks and check
+    that the run file it completes equals ``reference`` bit for bit in the datasets
+    ``keys``; returns the completed run file."""
+    import h5py
+    import numpy as np
+    res = run_cli(["run", "--restart", str(checkpoint), "--quiet"], ranks=ranks, timeout=timeout)
+    assert res.returncode == 0, res.stdout + res.stderr
+    out = Path(checkpoint).parent / "run.h5"
+    with h5py.File(out, "r") as f, h5py.File(reference, "r") as g:
+        for k in keys:
+            assert np.array_equal(f[k][...], g[k][...]), k
+    return out
+
+
 def run_mpi_script(script, ranks, *args, timeout=300):
     cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(script), *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=child_env())

@@ -5,7 +5,7 @@ import math
 import h5py
 import numpy as np
 import pytest
-from conftest import run_cli
+from conftest import restart_matches, run_cli
 
 from mpipd.input import scene as sc
 from mpipd.solver import Simulation
@@ -200,8 +200,7 @@ def test_bulk_viscosity_of_a_uniformly_compressed_charge(team, a):
         sim.gas.update(sim.u, sim.v, dt, 1.0)
         g = sim.gas
         full = g.offsets[g.gas_idx + 1] - g.offsets[g.gas_idx] >= 30
-        out[name] = (g.gd[g.gas_idx][full], g.gq[g.gas_idx][full], g.e[full], g.work[0],
-                     g.V0[full])
+        out[name] = (g.gd[g.gas_idx][full], g.gq[full], g.e[full], g.work, g.V0[full])
         dx = scene.parts[0].dx
     gd0, _, e0, _, _ = out["bare"]
     gd1, q, e1, work, V0 = out["visc"]
@@ -240,12 +239,9 @@ def test_bulk_viscosity_is_booked_and_survives_a_restart_on_another_rank_count(t
     assert res.returncode == 0, res.stdout + res.stderr
     res = run_cli(args + ["--out", str(d), "--stop-after", "40"], ranks=2, timeout=600)
     assert res.returncode == 0, res.stdout + res.stderr
-    res = run_cli(["run", "--restart", str(d / "checkpoint.h5"), "--quiet"], ranks=3,
-                  timeout=600)
-    assert res.returncode == 0, res.stdout + res.stderr
+    restart_matches(d / "checkpoint.h5", ref / "run.h5",
+                    ("fields/u", "fields/v", "fields/pressure"), ranks=3, timeout=600)
     with h5py.File(ref / "run.h5", "r") as f1, h5py.File(d / "run.h5", "r") as f:
-        for k in ("fields/u", "fields/v", "fields/pressure"):
-            assert np.array_equal(f[k][...], f1[k][...]), k
         e = f1["energy"]
         assert e["gas_viscous"][-1] > 0.0 and np.all(np.diff(e["gas_viscous"][...]) >= 0.0)
         assert np.abs(e["balance"][...]).max() < 1e-5

@@ -24,8 +24,7 @@ binds only where C_q |tr L| dt > 1/2, on a point deforming by tens of per cent i
 step: an escaped point with a sparse family, whose q would otherwise pump energy in).
 The energy equation below takes the work of the p part only; the work of the q part
 (of the same trapezoid, split in proportion p : q, which is exact because the force
-is linear in A) is dissipated and summed into ``work[0]`` as -W_q >= 0 (the ledger's
-``gas_viscous``).
+is linear in A) is dissipated, -W_q >= 0, and returned (the ledger's ``gas_viscous``).
 
 Energy.  The internal energy changes by exactly the trapezoidal work of the
 point's own force state (what the energy ledger books for every force, the
@@ -75,23 +74,24 @@ def current_bond(y, i, j):
 
 @numba.njit(cache=True)
 def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
-               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, gq, work, rho0=1.0, c_q=0.0,
+               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, gq, rho0=1.0, c_q=0.0,
                c_l=0.0, K_u=0.0, s_u=0.0, a_u=1.0):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
     (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
     step's pair weights, so the result does not depend on the update order) and
     ``V_pw`` those of the step before (the last force's weights).  Returns the
-    number of gas points with a singular M.  ``vr_lit[k]``: V_R of point k at the
-    step it is first lit (0 until then).  ``gq[i]``: the bulk viscosity q of the last
-    step, replaced by this step's; ``work[0]`` += the dissipated work of q (module
-    docstring); rho0, c_q, c_l: the charge's density and the viscosity's
-    coefficients.  K_u, s_u, a_u: the unreacted EOS
+    number of gas points with a singular M and the work the bulk viscosity took out
+    this step (J, module docstring).  ``vr_lit[k]``: V_R of point k at the step it is
+    first lit (0 until then).  ``gq[k]``: its bulk viscosity q of the last step,
+    replaced by this step's; rho0, c_q, c_l: the charge's density and the
+    viscosity's coefficients.  K_u, s_u, a_u: the unreacted EOS
     (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
     Mi = np.empty((3, 3))
     N = np.empty((3, 3))
     n_bad = 0
+    w_q = 0.0
     for k in range(gas_idx.shape[0]):
         i = gas_idx[k]
         di = delta[i]
@@ -140,8 +140,8 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             N[2, 2] += wgt * z2 * y2
             nb += 1
         W_a = wa * V_pw[i] * dt                  # of the last force, A^n = -(p^n + q^n) M^-1
-        ptot = gd[i, GD_P] + gq[i]
-        W_aq = W_a * gq[i] / ptot if ptot != 0.0 else 0.0
+        ptot = gd[i, GD_P] + gq[k]
+        W_aq = W_a * gq[k] / ptot if ptot != 0.0 else 0.0
         W_a -= W_aq                             # its p part (the energy equation's)
         M[1, 0] = M[0, 1]
         M[2, 0] = M[0, 2]
@@ -182,8 +182,8 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             rho = rho0 / VR
             q = rho * ell * (c_q * ell * trL * trL - c_l * math.sqrt(max(c2, 0.0)) * trL)
             q = min(q, -0.5 * rho * ell * ell * trL / dt)     # its explicit limit
-        work[0] -= 0.5 * (W_aq + q * bb)        # -W_q: the work q took out (trapezoid)
-        gq[i] = q
+        w_q -= 0.5 * (W_aq + q * bb)             # -W_q: the work q took out (trapezoid)
+        gq[k] = q
         gd[i, GD_V] = V_new
         gd[i, GD_P] = p
         p += q                                  # the force state's pressure
@@ -197,7 +197,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             gd[i, 3] = -p * Mi[1, 2]
             gd[i, 4] = -p * Mi[0, 2]
             gd[i, 5] = -p * Mi[0, 1]
-    return n_bad
+    return n_bad, w_q
 
 
 @numba.njit(cache=True)

@@ -101,8 +101,8 @@ class Gas(Model):
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
         self.c_q, self.c_l = m.bulk_viscosity
         self.viscous = self.c_q > 0.0 or self.c_l > 0.0
-        self.gq = np.zeros(p.n_local)            # bulk viscosity q of the last step
-        self.work = np.zeros(1)                  # dissipated work of q, this rank (J)
+        self.gq = np.zeros(len(self.gas_idx))    # bulk viscosity q of the last step
+        self.work = 0.0                          # dissipated work of q, this rank (J)
         self.y = None                            # current positions of the last update
 
     def register(self, state):
@@ -132,10 +132,10 @@ class Gas(Model):
         add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
         add("gas_y", own, get=lambda: self.y, rows=AUX)
-        add("gas_q", own, self.gq, rows=LOCAL, checkpoint=self.viscous)
+        add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
         if self.viscous:
-            state.scalar("gas_viscous_work", own, lambda: float(self.work[0]),
-                         lambda v: self.work.__setitem__(0, float(v)))
+            state.scalar("gas_viscous_work", own, lambda: self.work,
+                         lambda v: setattr(self, "work", float(v)))
         state.offer("pressure", own, self.pressure)
         # the every-step peak, whole run (a restart goes on from it)
         state.scalar("gas_peak_pressure", own, lambda: self.peak_pressure,
@@ -192,11 +192,12 @@ class Gas(Model):
         self.search(y)
         self.V_pw[:] = self.V_w                 # in place: the State holds these arrays
         self.V_w[:] = self.gd[:, GD_V]
-        self.n_singular = gas_update(
+        self.n_singular, wq = gas_update(
             self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, self.vr_lit,
-            self.gq, self.work, m.density, self.c_q, self.c_l, *m.unreacted_eos)
+            self.gq, m.density, self.c_q, self.c_l, *m.unreacted_eos)
+        self.work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
@@ -236,7 +237,7 @@ class Gas(Model):
     def viscous_work(self) -> float:
         """Work taken out by the gas's bulk viscosity on this rank (J, >= 0 to the
         trapezoid's accuracy): the ledger's ``gas_viscous``."""
-        return float(self.work[0])
+        return self.work
 
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""
