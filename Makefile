@@ -13,7 +13,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install paraview demo test bench lint clean
+.PHONY: install paraview lammps demo test bench lint clean
 
 install: $(STAMP)
 
@@ -25,6 +25,10 @@ $(STAMP): scripts/bootstrap.sh pyproject.toml
 paraview:
 	bash scripts/install_paraview.sh
 
+# Debian's lammps, the peer of `make bench`; a no-op once lmp is there
+lammps:
+	bash scripts/install_lammps.sh
+
 demo: install
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/demo --overwrite
 	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
@@ -34,7 +38,7 @@ demo: install
 test: install paraview
 	$(PY) -m pytest -q -ra tests
 
-bench: install
+bench: install lammps
 	$(PY) benchmarks/run.py
 	$(PY) benchmarks/fragments_bench.py
 
