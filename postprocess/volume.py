@@ -132,9 +132,8 @@ def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
     """Frame k: the explosive's points inside the rock's volume, and inside intact rock
     (module docstring); collective (every rank gets both counts)."""
     from scipy.spatial import cKDTree
-    y = (x[ig] + run.field("u", k, span=(int(ig[0]), int(ig[-1]) + 1))[ig - ig[0]]
-         if len(ig) else np.zeros((0, 3)))
-    y = np.concatenate(run.comm.allgather(y))           # every gas point, on every rank
+    u = run.field("u", k)                               # this rank's slice, read once
+    y = np.concatenate(run.comm.allgather(x[ig] + u[ig]))           # every gas point, on every rank
     ry = model.radius(y)
     inside = ((ry > model.r_wall + 0.5 * model.wall_dx) & (ry < model.r_out)
               & (y[:, 2] > model.z0) & (y[:, 2] < model.z1))
@@ -143,12 +142,10 @@ def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
     near = np.full(len(yi), np.inf)                     # distance / (sqrt(3)/2 h) of the
     intact = np.zeros(len(yi), bool)                    # nearest local rock point
     if len(ir) and len(yi):
-        span = (int(ir[0]), int(ir[-1]) + 1)
-        yr = x[ir] + run.field("u", k, span=span)[ir - ir[0]]
-        d, j = cKDTree(yr).query(yi)
+        d, j = cKDTree(x[ir] + u[ir]).query(yi)
         near = d / (0.5 * np.sqrt(3.0) * h_rock[j])
-        dmg = run.field("damage", k, span=span)[ir - ir[0]] if run.has_field("damage") else None
-        intact = np.ones(len(yi), bool) if dmg is None else dmg[j] < 0.5
+        intact = (run.field("damage", k)[ir[j]] < 0.5 if run.has_field("damage")
+                  else np.ones(len(yi), bool))
     # the nearest rock point over all ranks decides (ties: the lower rank)
     allnear = np.array(run.comm.allgather(near)).reshape(run.comm.Get_size(), -1)
     allint = np.array(run.comm.allgather(intact)).reshape(run.comm.Get_size(), -1)

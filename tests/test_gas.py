@@ -200,7 +200,7 @@ def test_bulk_viscosity_of_a_uniformly_compressed_charge(team, a):
         sim.gas.update(sim.u, sim.v, dt, 1.0)
         g = sim.gas
         full = g.offsets[g.gas_idx + 1] - g.offsets[g.gas_idx] >= 30
-        out[name] = (g.gd[g.gas_idx][full], g.gq[full], g.e[full], g.work, g.V0[full])
+        out[name] = (g.gd[g.gas_idx][full], g.gq[full], g.e[full], g.viscous_work, g.V0[full])
         dx = scene.parts[0].dx
     gd0, _, e0, _, _ = out["bare"]
     gd1, q, e1, work, V0 = out["visc"]

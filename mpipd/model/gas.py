@@ -102,7 +102,8 @@ class Gas(Model):
         self.c_q, self.c_l = m.bulk_viscosity
         self.viscous = self.c_q > 0.0 or self.c_l > 0.0
         self.gq = np.zeros(len(self.gas_idx))    # bulk viscosity q of the last step
-        self.work = 0.0                          # dissipated work of q, this rank (J)
+        self.viscous_work = 0.0                  # dissipated work of q, this rank (J): the
+        #                                          ledger's gas_viscous
         self.y = None                            # current positions of the last update
 
     def register(self, state):
@@ -134,8 +135,8 @@ class Gas(Model):
         add("gas_y", own, get=lambda: self.y, rows=AUX)
         add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
         if self.viscous:
-            state.scalar("gas_viscous_work", own, lambda: self.work,
-                         lambda v: setattr(self, "work", float(v)))
+            state.scalar("gas_viscous_work", own, lambda: self.viscous_work,
+                         lambda v: setattr(self, "viscous_work", float(v)))
         state.offer("pressure", own, self.pressure)
         # the every-step peak, whole run (a restart goes on from it)
         state.scalar("gas_peak_pressure", own, lambda: self.peak_pressure,
@@ -197,7 +198,7 @@ class Gas(Model):
             self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, self.vr_lit,
             self.gq, m.density, self.c_q, self.c_l, *m.unreacted_eos)
-        self.work += wq
+        self.viscous_work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
@@ -232,12 +233,6 @@ class Gas(Model):
             mean = team.sum(float(rho.sum())) / max(n_lit, 1)
             out[name] = {"max": mx, "mean": mean, "lit_fraction": n_lit / n_all}
         return out
-
-    @property
-    def viscous_work(self) -> float:
-        """Work taken out by the gas's bulk viscosity on this rank (J, >= 0 to the
-        trapezoid's accuracy): the ledger's ``gas_viscous``."""
-        return self.work
 
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""
