@@ -54,13 +54,17 @@ FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touche
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
 VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 72   # fd columns; dilatation, viscous force (2 steps)
 JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
-GAS_LOCAL, GAS_OWNED = 90, 32   # gas force data (8), flags, gas horizon, pair weights (2 steps);
-#                                 UL offsets, V ratio, damping, the ledger's damping energy
+GAS_LOCAL, GAS_OWNED = 147, 32  # gas force data (8), flags, gas horizon, pair weights (2 steps),
+#                                 the kernels' positions, velocities, flags and horizons over
+#                                 local + remote rows; UL offsets, V ratio, damping, the
+#                                 ledger's damping energy
 PEAKS_OWNED = 24                # peak_pressure, peak_sigma_rr, peak_speed (if asked for)
 BYTES_PER_GAS_POINT = 56        # index, V0, e, lighting time, not-TL index, density at
 #                                 lighting, last bulk q
-BYTES_PER_UL_POINT = 16         # the UL search lists (eligible, rows): the gas and the
-#                                 points of its interacts_with solids, on every rank
+BYTES_PER_UL_POINT = 64         # the UL search lists (eligible, rows, their extension, the
+#                                 watched points and their positions at the last search, the
+#                                 owned solids; an upper bound): the gas and the rank's points
+#                                 of its interacts_with solids
 
 
 def is_gas_part(scene, part) -> bool:
@@ -70,8 +74,9 @@ def is_gas_part(scene, part) -> bool:
 def memory_model(scene) -> tuple[int, int]:
     """(bytes per local point, bytes per owned point) for the scene's features; a
     scene with an explosive adds BYTES_PER_GAS_POINT per gas point and
-    BYTES_PER_UL_POINT per point the gas searches (gas and ``interacts_with``
-    solids) on every rank (plus its current-configuration families)."""
+    BYTES_PER_UL_POINT per point the gas searches (every gas point, and the rank's
+    points of the ``interacts_with`` solids) (plus its current-configuration
+    families and the few remote solid rows, mpipd.parallel.near)."""
     local, owned = BYTES_PER_LOCAL_POINT, BYTES_PER_OWNED_POINT
     gas = any(is_gas_part(scene, q) for q in scene.parts)
     if gas:
@@ -192,8 +197,10 @@ def check_report(scene, ranks: int) -> str:
     out = [f"scene {scene.name!r}: {scene.scene.description}".rstrip(": ")]
     out.append(f"  steps: {scene.time.n_steps} of dt = {dt:.4e} s "
                f"(t_end = {scene.time.n_steps * dt:.4e} s)")
-    gas_points = ul_points = 0
-    ul_parts = set(replicated_parts(scene))      # what the gas searches: gas + interacts_with
+    gas_points = 0
+    acted = {a for m in scene.gas_materials for a in scene.materials[m].interacts_with}
+    ul_parts = [k for k, q in enumerate(scene.parts)       # what the gas searches
+                if is_gas_part(scene, q) or q.material in acted]
     part_dt = {}
     for k, p in enumerate(scene.parts):
         sel = table.part == k
@@ -202,8 +209,6 @@ def check_report(scene, ranks: int) -> str:
         mat = scene.materials[p.material]
         if is_gas_part(scene, p):
             gas_points += npts
-        if k in ul_parts:
-            ul_points += npts
         dt_sa, dt_cfl = part_dt[k] = stable_dt(p, mat)
         fam = len(bulk_family(p.dx, p.horizon))
         out.append(f"  part {p.name!r}: {p.shape.registry_name}, material {p.material!r} "
@@ -212,8 +217,9 @@ def check_report(scene, ranks: int) -> str:
                    + ("updated-Lagrangian gas: families re-found every step, held on every rank"
                       if is_gas_part(scene, p) else
                       f"{nb} bonds ({nb / max(npts, 1):.1f} per point, {fam} in the bulk)"
-                      + ("; the gas acts on it: held on every rank" if k in slabs.replicated
-                         else "")))
+                      + ("; the gas acts on it (held as its slabs are; the points a gas "
+                         "point reaches beyond its rank's halo come from their owners)"
+                         if k in ul_parts else "")))
         out.append(f"    stable dt: Silling-Askari {dt_sa:.4e} s, dx/c_p {dt_cfl:.4e} s "
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
         if is_gas_part(scene, p):
@@ -320,6 +326,8 @@ def check_report(scene, ranks: int) -> str:
         z0, z1 = slabs.z_range(r)
         a, b = slabs.owned(r)
         nb = int(bonds[a:b].sum())
+        held = np.concatenate((np.arange(a, b), slabs.ghost_layers(r)))
+        ul_points = int(table.count[held][np.isin(table.part[held], ul_parts)].sum())
         mem = (per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * nb
                + BYTES_PER_GAS_POINT * gas_points + BYTES_PER_UL_POINT * ul_points)
         thick = z1 - z0 + float(scene.max_dx)

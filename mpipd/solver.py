@@ -4,7 +4,8 @@
 the run's :class:`mpipd.parallel.team.Team`:
 
 1. layer table -> slab decomposition -> this rank's owned + ghost points only
-   (the explosive gas and its ``interacts_with`` solids: all of them, as ghosts);
+   (the explosive gas: all of it, as ghosts; the solids it reaches beyond the
+   halo come as remote rows, mpipd.parallel.near);
 2. halo plan, families (CSR, gid-sorted), material groups, correspondence state;
 3. initial and boundary conditions, initial forces.
 
@@ -49,7 +50,7 @@ from .state import AUX, LAST, LOCAL, State
 
 #: model family (``Material.family``) -> the model its points are, beyond the
 #: correspondence solids ("tl", always built: it holds every point's kinematics);
-#: built as ``cls(scene, points, team)`` when some part is of such a material
+#: built as ``cls(scene, points, team, slabs)`` when some part is of such a material
 FAMILY_MODELS: dict[str, type[Model]] = {"ul": Gas}
 
 
@@ -64,7 +65,7 @@ class Simulation:
         self.dt = scene.time.dt
         table = LayerTable.from_parts(scene.parts, scene.material_ids)
         gas_parts = scene.gas_parts
-        # the gas and the solids it acts on are held whole on every rank
+        # the gas is held whole on every rank (the solids it acts on: mpipd.parallel.near)
         self.slabs = decompose(table, team.size, halo_width(scene), replicated_parts(scene))
         self.n_global = table.n_points
         self.gid_range = self.slabs.gid_range(team.rank)
@@ -150,7 +151,7 @@ class Simulation:
         used = {scene.materials[q.material].family for q in scene.parts}
         for family, cls in FAMILY_MODELS.items():
             if family in used:
-                model = cls(scene, p, team)
+                model = cls(scene, p, team, self.slabs)
                 model.register(st)
                 self.models.append(model)
         self.gas = next((m for m in self.models if isinstance(m, Gas)), None)

@@ -91,21 +91,28 @@ def test_too_many_ranks_refused():
         decompose(table, 4, halo_width(scene))
 
 
-def test_gas_and_the_solids_it_acts_on_are_on_every_rank():
-    """detonation_tube: the charge and the copper it acts on (interacts_with) are held
-    whole on every rank; the rock, which the gas does not touch, only within the halo."""
+def test_the_gas_is_on_every_rank_and_the_solids_only_in_their_slabs():
+    """detonation_tube: the charge is held whole on every rank; the copper it acts on
+    (interacts_with) and the rock, only within the halo (a gas point's solids beyond
+    it come as remote rows, mpipd.parallel.near); ``holds`` says exactly which
+    layers a rank has."""
     from mpipd.input import scene as sc
     from mpipd.parallel.decomp import replicated_parts
     scene, _ = sc.load("detonation_tube")
     names = [q.name for q in scene.parts]
-    assert [names[k] for k in replicated_parts(scene)] == ["charge", "tube"]
+    assert [names[k] for k in replicated_parts(scene)] == ["charge"]
     table = LayerTable.from_parts(scene.parts, scene.material_ids)
     slabs = decompose(table, 3, halo_width(scene), replicated_parts(scene))
+    every = np.arange(len(table.z))
     for r in range(3):
         p = local_points(scene, slabs, r)
-        for k in (0, 1):
-            assert np.sum(p.part == k) == table.count[table.part == k].sum()
-        rock = p.part == 2
+        assert np.sum(p.part == 0) == table.count[table.part == 0].sum()
         z0, z1 = slabs.z_range(r)
-        assert rock.sum() < table.count[table.part == 2].sum()
-        assert np.all((p.x[rock, 2] > z0 - slabs.halo) & (p.x[rock, 2] < z1 + slabs.halo))
+        for k in (1, 2):
+            solid = p.part == k
+            assert solid.sum() < table.count[table.part == k].sum()
+            assert np.all((p.x[solid, 2] > z0 - slabs.halo) & (p.x[solid, 2] < z1 + slabs.halo))
+        held = np.unique(slabs.layer_of(p.gid))
+        assert np.array_equal(every[slabs.holds(r, every)], held)
+        assert np.array_equal(slabs.owner_of_gid(p.gid[:p.n_owned]),
+                              np.full(p.n_owned, r))

@@ -285,7 +285,7 @@ def test_gas_has_no_bonds_and_does_not_touch_rock(team):
     gas = sim.gas.is_gas.astype(bool)
     rows = np.repeat(np.arange(p.n_owned), np.diff(fam.offsets))
     assert not gas[rows].any() and not gas[fam.nbr].any()        # no TL bond touches gas
-    sim.gas.search(sim.points.x + sim.u)
+    sim.gas.search(sim.points.x + sim.u, sim.v)
     g = sim.gas
     ul_rows = np.repeat(np.arange(p.n_owned), np.diff(g.offsets))
     names = list(scene.materials)
@@ -474,7 +474,7 @@ def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
     from types import SimpleNamespace
 
     from mpipd.model.gas import Gas
-    gas = SimpleNamespace(rows=rows, eligible=el, reach=h.max(), skin=skin, gas_horizon=h,
-                          points=SimpleNamespace(gid=gid))
+    gas = SimpleNamespace(rows=rows, el_ext=el, reach=h.max(), skin=skin, h_ext=h,
+                          gid_ext=gid)
     c2, n2 = Gas._tree_pairs(gas, y, n)
     assert np.array_equal(c2, counts) and np.array_equal(n2, nbr)

@@ -98,3 +98,19 @@ def cell_pairs(y, rows, el, h, skin, cell, lo, dims, gid, n_rows):
     nbr = np.empty(start[n_rows], np.int32)
     _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, nbr, start, True)
     return counts, nbr
+
+
+@numba.njit(cache=True)
+def max_moved2(y, idx, y_built):
+    """Largest squared distance |y[idx[k]] - y_built[k]|^2 (0 for no points): how far
+    the Verlet list's points have moved since it was built."""
+    m = 0.0
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        d0 = y[i, 0] - y_built[k, 0]
+        d1 = y[i, 1] - y_built[k, 1]
+        d2 = y[i, 2] - y_built[k, 2]
+        d = d0 * d0 + d1 * d1 + d2 * d2
+        if d > m:
+            m = d
+    return m

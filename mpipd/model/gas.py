@@ -3,20 +3,23 @@ detonation (paper §2.6, Eqs. 45–48).  Built only when a scene has a ``jwl``
 material.
 
 * Every rank holds every gas point (owned, or as a ghost: the halo replicates the
-  gas, which moves far from its reference slab, and is a few per cent of a model),
-  and every point of the ``interacts_with`` solids: a gas point may come within its
-  horizon of any of them, however far it is from its owner's slab
-  (:func:`mpipd.parallel.decomp.replicated_parts`).
+  gas, which moves far from its reference slab, and is a few per cent of a model;
+  :func:`mpipd.parallel.decomp.replicated_parts`).  The solids it acts on (its
+  ``interacts_with`` materials) are held as their slabs are; the ones an owned gas
+  point may reach beyond this rank's static halo come as *remote* rows from their
+  owners (:class:`mpipd.parallel.near.NearHalo`), appended after the local points
+  in the arrays the gas kernels read (``y_ext``, ``v_ext``, ...).
 * Families live in the current configuration: for each owned gas point, the gas
   and the ``interacts_with`` solids within the gas horizon; for each owned such
   solid, the gas points whose horizon reaches it.  No total-Lagrangian bond
-  touches a gas point, and there are no gas-rock bonds unless the scene lists
-  the rock.  They are searched with a cell list (mpipd.kernels.search; a cKDTree
+  touches a gas point, and there are no gas-solid pairs with solids the scene does
+  not list.  They are searched with a cell list (mpipd.kernels.search; a cKDTree
   if the points spread too far for its keys) out to the horizon plus a skin
-  (Verlet list, SKIN x the gas horizon) and searched again only once some
-  eligible point has moved more than half the skin since: until then every pair
-  within the horizon is in the list.  The kernels keep only pairs inside the
-  horizon, in gid order, so the result is exactly that of a search every step.
+  (Verlet list, SKIN x the gas horizon) and searched again (with a new remote
+  plan) only once some gas point or owned acted-on solid, on any rank, has moved
+  more than half the skin since: until then every pair within the horizon is in
+  the list.  The kernels keep only pairs inside the horizon, in gid order, so the
+  result is exactly that of a search every step, on any number of ranks.
 * It is the "ul" model family (:class:`mpipd.model.base.Model`): ``update`` moves
   the families, volume, energy and pressure on; ``force_data`` hands the halo the
   force data ``gd`` that ``update`` made; ``gather`` adds the pair forces.
@@ -33,8 +36,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
-from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs
+from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2
 from ..kernels.ul import gas_gather, gas_update
+from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
 from .base import Model
 from .families import _csr_by_row
@@ -60,23 +64,29 @@ def lighting_times(scene, part: np.ndarray, z: np.ndarray, mat) -> np.ndarray:
 class Gas(Model):
     name = "gas"
 
-    def __init__(self, scene, points, team):
+    def __init__(self, scene, points, team, slabs=None):
         """The gas of ``scene`` among this rank's ``points`` (collective: the search
-        reach is the largest gas horizon over all ranks)."""
+        reach is the largest gas horizon over all ranks; ``slabs``, the
+        decomposition, for the remote solids of a run on several ranks)."""
         p = points
         names = list(scene.materials)
         explosives = scene.gas_materials
         self.mat = scene.materials[explosives[0]]
         gas_ids = [names.index(m) for m in explosives]
         acts = {a for m in explosives for a in scene.materials[m].interacts_with}
-        n = p.n_owned
+        n, nl = p.n_owned, p.n_local
         self.points = p
+        self.team = team
         self.is_gas = np.isin(p.material, gas_ids).astype(np.uint8)
-        self.eligible = np.flatnonzero(self.is_gas.astype(bool)
-                                       | np.isin(p.material, [names.index(a) for a in acts]))
+        solid = np.isin(p.material, [names.index(a) for a in acts])
+        self.eligible = np.flatnonzero(self.is_gas.astype(bool) | solid)   # local ones
         self.rows = self.eligible[self.eligible < n]
         self.gas_idx = np.flatnonzero(self.is_gas[:n]).astype(np.int64)
-        self.gd = np.zeros((p.n_local, GD_WIDTH))           # A (6), V, p
+        gas_all = np.flatnonzero(self.is_gas).astype(np.int64)
+        self.solids_owned = np.flatnonzero(solid[:n]).astype(np.int64)
+        # whose motion triggers a new search: every gas point, this rank's solids
+        self.watch = np.union1d(gas_all, self.solids_owned)
+        self.gd = np.zeros((nl, GD_WIDTH))           # A (6), V, p
         self.gd[self.is_gas.astype(bool), GD_V] = p.volume[self.is_gas.astype(bool)]
         self.V0 = p.volume[self.gas_idx].copy()
         self.e = np.full(len(self.gas_idx), self.mat.e0)
@@ -87,14 +97,14 @@ class Gas(Model):
         dx = float(p.dx[self.gas_idx].max()) if len(self.gas_idx) else 0.0
         self.t_ramp = m.burn_ramp * dx / m.vod
         self.gas_horizon = np.where(self.is_gas.astype(bool), p.horizon, 0.0)
-        self.reach = team.max(float(self.gas_horizon.max()) if p.n_local else 0.0)
+        self.reach = team.max(float(self.gas_horizon.max()) if nl else 0.0)
         self.V_ratio = np.ones(n)                # V_w / V0 of the owned gas (1 elsewhere)
         self.V_w = self.gd[:, GD_V].copy()          # this step's pair weights (start-of-step V)
         self.V_pw = self.V_w.copy()              # the last step's
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
         self.skin = SKIN * self.reach
-        self.y_built = None                      # eligible points' positions at the last search
+        self.y_built = None                      # watched points' positions at the last search
         self.searches = 0
         self.search_seconds = 0.0
         self.n_singular = 0
@@ -104,7 +114,30 @@ class Gas(Model):
         self.gq = np.zeros(len(self.gas_idx))    # bulk viscosity q of the last step
         self.viscous_work = 0.0                  # dissipated work of q, this rank (J): the
         #                                          ledger's gas_viscous
-        self.y = None                            # current positions of the last update
+        self.near = None                         # the remote solids (several ranks)
+        if slabs is not None and team.size > 1 and len(acts):
+            self.near = _near_halo(team.comm, slabs, p, self.solids_owned, gas_all)
+        self._extend(0)
+        self.y = None                            # current positions (y_ext) of the last update
+
+    def _extend(self, n_remote: int):
+        """The arrays the gas kernels read over local and remote rows: positions and
+        velocities (filled every step), and volume, gid, gas flag and gas horizon
+        (a remote row is a solid: flag 0, horizon 0)."""
+        p = self.points
+        nl = p.n_local
+        near = self.near
+        self.y_ext = np.zeros((nl + n_remote, 3))
+        self.v_ext = np.zeros((nl + n_remote, 3))
+        if n_remote:
+            self.vol_ext = np.concatenate((p.volume, near.remote_volume))
+            self.gid_ext = np.concatenate((p.gid, near.remote_gid))
+        else:
+            self.vol_ext, self.gid_ext = p.volume, p.gid
+        self.isgas_ext = np.concatenate((self.is_gas, np.zeros(n_remote, np.uint8)))
+        self.h_ext = np.concatenate((self.gas_horizon, np.zeros(n_remote)))
+        self.el_ext = np.concatenate((self.eligible,
+                                      np.arange(nl, nl + n_remote, dtype=self.eligible.dtype)))
 
     def register(self, state):
         """The gas's arrays in the State (owner "gas") under the checkpoint names of
@@ -126,13 +159,14 @@ class Gas(Model):
         add("gas_vr_lit", own, self.vr_lit, rows=self.gas_idx, checkpoint=True)
         add("gas_is_gas", own, self.is_gas, rows=LOCAL)
         add("gas_horizon", own, self.gas_horizon, rows=LOCAL)
-        for name in ("eligible", "rows", "gas_idx"):
+        for name in ("eligible", "rows", "gas_idx", "watch", "solids_owned"):
             add(f"gas_{name}" if name != "gas_idx" else name, own, getattr(self, name),
                 rows=AUX)
         add("gas_offsets", own, get=lambda: self.offsets, rows=AUX)
         add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
-        add("gas_y", own, get=lambda: self.y, rows=AUX)
+        for name in ("y_ext", "v_ext", "isgas_ext", "h_ext", "el_ext"):
+            add(f"gas_{name}", own, get=lambda name=name: getattr(self, name), rows=AUX)
         add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
         if self.viscous:
             state.scalar("gas_viscous_work", own, lambda: self.viscous_work,
@@ -147,56 +181,71 @@ class Gas(Model):
         halo.exchange(self.V_w)
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
 
-    def search(self, y):
-        """Current-configuration families (positions y), each sorted by neighbour gid:
-        every pair closer than the larger gas horizon plus the skin.  Skipped while
-        no eligible point has moved half the skin since the last search."""
+    def _stale(self, y) -> bool:
+        """Has some watched point, on any rank, moved half the skin since the last
+        search (or was there none)?  Collective on several ranks."""
+        if self.y_built is None:
+            stale = True
+        else:
+            stale = max_moved2(y, self.watch, self.y_built) >= (0.5 * self.skin) ** 2
+        if self.near is not None:
+            stale = bool(self.team.max(int(stale)))
+        return stale
+
+    def search(self, y, v):
+        """Fill y_ext, v_ext from the local ``y``, ``v`` and the remote rows' owners;
+        then, if stale (:meth:`_stale`), a new remote plan and current-configuration
+        families, each sorted by neighbour gid: every pair closer than the larger gas
+        horizon plus the skin."""
         t0 = time.perf_counter()
         p = self.points
-        el = self.eligible
-        n = p.n_owned
-        if self.y_built is not None:
-            d = y[el] - self.y_built
-            moved = float(np.einsum("ij,ij->i", d, d).max()) if len(el) else 0.0
-            if moved < (0.5 * self.skin) ** 2:
-                self.search_seconds += time.perf_counter() - t0
-                return
-        self.y_built = y[el]
-        self.searches += 1
-        if len(self.rows) and len(el):
-            cell = self.reach + self.skin
-            lo, dims = cell_counts(y[el], cell)
-            if float(np.prod(dims.astype(float))) < MAX_CELLS:
-                counts, self.nbr = cell_pairs(y, self.rows, el, self.gas_horizon, self.skin,
-                                              cell, lo, dims, p.gid, n)
-            else:                               # spread too far for int64 cell keys
-                counts, self.nbr = self._tree_pairs(y, n)
-            self.offsets[1:] = np.cumsum(counts)
-        else:
-            self.offsets[:] = 0
+        nl, n = p.n_local, p.n_owned
+        stale = self._stale(y)
+        if stale and self.near is not None:
+            self._extend(self.near.plan(y, self.reach + self.skin))
+        ye, ve = self.y_ext, self.v_ext
+        ye[:nl] = y
+        ve[:nl] = v
+        if self.near is not None:
+            self.near.exchange(ye, ve)
+        if stale:
+            self.y_built = y[self.watch]
+            self.searches += 1
+            el = self.el_ext
+            if len(self.rows) and len(el):
+                cell = self.reach + self.skin
+                lo, dims = cell_counts(ye[el], cell)
+                if float(np.prod(dims.astype(float))) < MAX_CELLS:
+                    counts, self.nbr = cell_pairs(ye, self.rows, el, self.h_ext, self.skin,
+                                                  cell, lo, dims, self.gid_ext, n)
+                else:                               # spread too far for int64 cell keys
+                    counts, self.nbr = self._tree_pairs(ye, n)
+                self.offsets[1:] = np.cumsum(counts)
+            else:
+                self.offsets[:] = 0
         self.search_seconds += time.perf_counter() - t0
 
     def _tree_pairs(self, y, n):
         """The same pairs by a k-d tree (points spread beyond the cell keys' range)."""
-        el = self.eligible
+        el = self.el_ext
         m = cKDTree(y[self.rows]).sparse_distance_matrix(
             cKDTree(y[el]), self.reach + self.skin, output_type="ndarray")
         i, j = self.rows[m["i"]], el[m["j"]]
-        h = self.gas_horizon
+        h = self.h_ext
         keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
-        return _csr_by_row(i[keep], j[keep], self.points.gid, n)
+        return _csr_by_row(i[keep], j[keep], self.gid_ext, n)
 
     def update(self, u, v, dt: float, t: float):
         """Families, then volume, energy, pressure and force data of the owned gas."""
         p, m = self.points, self.mat
-        y = self.y = p.x + u                    # current positions, kept for gather()
-        self.search(y)
+        self.search(p.x + u, v)
+        y = self.y = self.y_ext                 # current positions, kept for gather()
         self.V_pw[:] = self.V_w                 # in place: the State holds these arrays
         self.V_w[:] = self.gd[:, GD_V]
         self.n_singular, wq = gas_update(
-            self.gas_idx, y, v, p.volume, self.V_w, self.V_pw, self.gd, p.horizon,
-            self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
-            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.is_gas, self.vr_lit,
+            self.gas_idx, y, self.v_ext, self.vol_ext, self.V_w, self.V_pw, self.gd,
+            p.horizon, self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
+            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.isgas_ext, self.vr_lit,
             self.gq, m.density, self.c_q, self.c_l, *m.unreacted_eos)
         self.viscous_work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
@@ -208,11 +257,14 @@ class Gas(Model):
         return (self.gd,)
 
     def gather(self, u, v, f, fv=None):
-        """UL forces into f; u must be the displacement update() last saw."""
+        """UL forces into f; u must be the displacement update() last saw, or the
+        positions are taken from u (``y`` None: at step 0, after a restore)."""
         p = self.points
-        y = self.y if self.y is not None else p.x + u
-        gas_gather(self.rows, y, p.volume, self.V_w, self.V_ratio, self.gd, p.horizon,
-                   self.offsets, self.nbr, self.is_gas, f)
+        if self.y is None:                      # positions from u (collective)
+            self.search(p.x + u, v)
+            self.y = self.y_ext
+        gas_gather(self.rows, self.y, self.vol_ext, self.V_w, self.V_ratio, self.gd,
+                   p.horizon, self.offsets, self.nbr, self.isgas_ext, f)
 
     def lit_density(self, team) -> dict:
         """Per charge (part name): the largest and the mean density at lighting over
@@ -243,3 +295,13 @@ class Gas(Model):
         out = np.zeros(self.points.n_owned)
         out[self.gas_idx] = self.gd[self.gas_idx, GD_P]
         return out
+
+
+def _near_halo(comm, slabs, p, solids_owned, gas_all) -> NearHalo:
+    """The remote-solid halo of this rank: which of its owned acted-on solids each
+    peer lacks (beyond the peer's static halo), and who owns each gas point."""
+    r = comm.Get_rank()
+    layer = slabs.layer_of(p.gid[solids_owned])
+    lacks = {q: ~slabs.holds(q, layer) for q in range(slabs.n_ranks) if q != r}
+    return NearHalo(comm, p.n_local, solids_owned, lacks, gas_all,
+                    slabs.owner_of_gid(p.gid[gas_all]), p.volume, p.gid)

@@ -12,11 +12,13 @@ rank within reach, not just the neighbours, and the halo exchanges directly
 with each of them (see :mod:`mpipd.parallel.halo`).  Only a rank with no z level at all
 is refused.
 
-Replicated parts.  The explosive gas moves far from its reference slab, and
-the solids it acts on (its ``interacts_with`` materials) are in its family
-wherever it goes, so both are held whole on every rank (:func:`replicated_parts`):
-a gas point owned by rank r may come within a horizon of a solid point whose
-layer is beyond r's halo, and r must see that point as the 1-rank run does.
+Replicated parts.  The explosive gas moves far from its reference slab, so it
+is held whole on every rank (:func:`replicated_parts`).  The solids it acts on
+(its ``interacts_with`` materials) are in its family wherever it goes: a gas
+point owned by rank r may come within a horizon of a solid point whose layer is
+beyond r's halo, and r must see that point as the 1-rank run does.  Those few
+points come to r as remote rows, chosen afresh with the gas's Verlet list
+(:class:`mpipd.parallel.near.NearHalo`).
 
 Local layout on a rank: owned points first (gid order), then ghosts (gid
 order).  Because owners hold contiguous gid ranges, the ghosts coming from one
@@ -42,7 +44,7 @@ class Slabs:
     table: LayerTable
     bounds: np.ndarray          # rank r owns layers [bounds[r], bounds[r+1])
     halo: float
-    replicated: frozenset = frozenset()  # parts held whole on every rank (gas, and what it acts on)
+    replicated: frozenset = frozenset()  # parts held whole on every rank (the gas)
 
     @property
     def n_ranks(self) -> int:
@@ -50,6 +52,23 @@ class Slabs:
 
     def owned(self, r: int) -> tuple[int, int]:
         return int(self.bounds[r]), int(self.bounds[r + 1])
+
+    def layer_of(self, gid) -> np.ndarray:
+        """The layer of each global id."""
+        return np.searchsorted(self.table.start, gid, side="right") - 1
+
+    def owner_of_gid(self, gid) -> np.ndarray:
+        """The rank that owns each global id."""
+        return self.owner_of_layer(self.layer_of(gid))
+
+    def holds(self, r: int, layer) -> np.ndarray:
+        """Does rank r hold (own, or as a ghost) each of these layers?"""
+        layer = np.asarray(layer)
+        lo, hi = self.reach(r)
+        held = (layer >= lo) & (layer < hi)
+        if self.replicated:
+            held |= np.isin(self.table.part[layer], list(self.replicated))
+        return held
 
     def owner_of_layer(self, layer) -> np.ndarray:
         return np.searchsorted(self.bounds, layer, side="right") - 1
@@ -202,13 +221,11 @@ def local_points(scene, slabs: Slabs, r: int) -> Points:
 
 def replicated_parts(scene) -> list[int]:
     """Indices of the parts every rank holds whole: the explosive gas (``gas_materials``
-    materials) and the parts of every material an explosive ``interacts_with``.
-    A gas point's current family is every such point within its horizon of its
-    current position, which may be any distance from its owner's slab."""
-    mats = scene.materials
+    materials), which may move any distance from its owner's slab.  The solids it
+    acts on are not replicated: the ones a gas point reaches beyond its owner's
+    static halo come from their owners as remote rows (mpipd.parallel.near)."""
     gas = set(scene.gas_materials)
-    acts = {a for m in gas for a in mats[m].interacts_with}
-    return [k for k, q in enumerate(scene.parts) if q.material in gas | acts]
+    return [k for k, q in enumerate(scene.parts) if q.material in gas]
 
 
 def halo_width(scene) -> float:
