@@ -471,10 +471,22 @@ def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
     assert counts.sum() == sum(len(v) for v in want.values()) > 0
     for i in range(n):
         assert list(nbr[off[i]:off[i + 1]]) == want.get(i, [])
+    # the gas's families: a solid row among the gas only (a solid-solid pair carries
+    # no force), by the split cell lists and by the k-d tree
     from types import SimpleNamespace
 
     from mpipd.model.gas import Gas
+    is_gas = (h > 0).astype(np.uint8)
+    gas_all = np.flatnonzero(is_gas)
     gas = SimpleNamespace(rows=rows, el_ext=el, reach=h.max(), skin=skin, h_ext=h,
-                          gid_ext=gid)
+                          gid_ext=gid, isgas_ext=is_gas, gas_all=gas_all[np.isin(gas_all, el)],
+                          gas_idx=rows[is_gas[rows] > 0], solids_owned=rows[is_gas[rows] == 0],
+                          offsets=np.zeros(n + 1, np.int64))
+    want = {i: [j for j in js if is_gas[i] or is_gas[j]] for i, js in want.items()}
+    Gas._pairs(gas, y, n)
     c2, n2 = Gas._tree_pairs(gas, y, n)
-    assert np.array_equal(c2, counts) and np.array_equal(n2, nbr)
+    assert np.array_equal(np.diff(gas.offsets), c2) and np.array_equal(gas.nbr, n2)
+    off = gas.offsets
+    assert off[-1] == sum(len(v) for v in want.values()) > 0
+    for i in range(n):
+        assert list(n2[off[i]:off[i + 1]]) == want.get(i, [])

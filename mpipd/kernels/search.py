@@ -114,3 +114,23 @@ def max_moved2(y, idx, y_built):
         if d > m:
             m = d
     return m
+
+
+@numba.njit(cache=True)
+def merge_rows(ca, na, cb, nb):
+    """One CSR (counts, nbr) from two over the same rows, each row filled by at most
+    one of them (e.g. the gas rows' families and the solid rows')."""
+    n = ca.shape[0]
+    counts = ca + cb
+    nbr = np.empty(na.shape[0] + nb.shape[0], np.int32)
+    pa = pb = k = 0
+    for i in range(n):
+        for _ in range(ca[i]):
+            nbr[k] = na[pa]
+            pa += 1
+            k += 1
+        for _ in range(cb[i]):
+            nbr[k] = nb[pb]
+            pb += 1
+            k += 1
+    return counts, nbr

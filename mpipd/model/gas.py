@@ -36,7 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
-from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2
+from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows
 from ..kernels.ul import gas_gather, gas_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
@@ -82,7 +82,7 @@ class Gas(Model):
         self.eligible = np.flatnonzero(self.is_gas.astype(bool) | solid)   # local ones
         self.rows = self.eligible[self.eligible < n]
         self.gas_idx = np.flatnonzero(self.is_gas[:n]).astype(np.int64)
-        gas_all = np.flatnonzero(self.is_gas).astype(np.int64)
+        gas_all = self.gas_all = np.flatnonzero(self.is_gas).astype(np.int64)
         self.solids_owned = np.flatnonzero(solid[:n]).astype(np.int64)
         # whose motion triggers a new search: every gas point, this rank's solids
         self.watch = np.union1d(gas_all, self.solids_owned)
@@ -211,19 +211,36 @@ class Gas(Model):
         if stale:
             self.y_built = y[self.watch]
             self.searches += 1
-            el = self.el_ext
-            if len(self.rows) and len(el):
-                cell = self.reach + self.skin
-                lo, dims = cell_counts(ye[el], cell)
-                if float(np.prod(dims.astype(float))) < MAX_CELLS:
-                    counts, self.nbr = cell_pairs(ye, self.rows, el, self.h_ext, self.skin,
-                                                  cell, lo, dims, self.gid_ext, n)
-                else:                               # spread too far for int64 cell keys
-                    counts, self.nbr = self._tree_pairs(ye, n)
-                self.offsets[1:] = np.cumsum(counts)
-            else:
-                self.offsets[:] = 0
+            self._pairs(ye, n)
         self.search_seconds += time.perf_counter() - t0
+
+    def _pairs(self, ye, n):
+        """The families at positions ``ye`` (local + remote rows): each owned gas point
+        among every candidate (gas and solids), each owned solid among the gas only
+        (a solid-solid pair carries no force), solids farther than the reach from
+        the gas's bounding box skipped."""
+        el, gas = self.el_ext, self.gas_all
+        if not len(self.rows) or not len(gas):
+            self.offsets[:] = 0
+            self.nbr = np.zeros(0, np.int32)
+            return
+        cell = self.reach + self.skin
+        lo, dims = cell_counts(ye[el], cell)
+        if not float(np.prod(dims.astype(float))) < MAX_CELLS:   # too spread for int64 keys
+            counts, self.nbr = self._tree_pairs(ye, n)
+        else:
+            ca, na = cell_pairs(ye, self.gas_idx, el, self.h_ext, self.skin, cell, lo, dims,
+                                self.gid_ext, n)
+            sol = self.solids_owned
+            yg = ye[gas]
+            ys = ye[sol]
+            near = np.all((ys >= yg.min(axis=0) - cell) & (ys <= yg.max(axis=0) + cell), axis=1)
+            sol = sol[near]
+            lo, dims = cell_counts(yg, cell)
+            cb, nb = cell_pairs(ye, sol, gas, self.h_ext, self.skin, cell, lo, dims,
+                                self.gid_ext, n)
+            counts, self.nbr = merge_rows(ca, na, cb, nb)
+        self.offsets[1:] = np.cumsum(counts)
 
     def _tree_pairs(self, y, n):
         """The same pairs by a k-d tree (points spread beyond the cell keys' range)."""
@@ -231,8 +248,9 @@ class Gas(Model):
         m = cKDTree(y[self.rows]).sparse_distance_matrix(
             cKDTree(y[el]), self.reach + self.skin, output_type="ndarray")
         i, j = self.rows[m["i"]], el[m["j"]]
-        h = self.h_ext
-        keep = (i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
+        h, g = self.h_ext, self.isgas_ext
+        keep = ((i != j) & (m["v"] < np.maximum(h[i], h[j]) + self.skin)
+                & ((g[i] > 0) | (g[j] > 0)))
         return _csr_by_row(i[keep], j[keep], self.gid_ext, n)
 
     def update(self, u, v, dt: float, t: float):
