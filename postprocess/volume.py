@@ -21,11 +21,13 @@ rank reads one frame of one field of its own slice at a time).
   current position lies inside the rock, R_b + wall_dx/2 < r < R_o and z0 < z < z1
   (more than half a rock spacing beyond the borehole wall, within the specimen),
   and of those the ones **inside intact rock**: their nearest rock point (current
-  positions) is within sqrt(3)/2 of its dx, a lattice cell's half-diagonal, and has
-  damage < 0.5.  Gas may enter the rock through its cracks and crushed zone, but not
-  intact rock: there it has passed through the tube and the wall, which its pressure
-  state alone does not prevent.  Any point in intact rock makes the block an error
-  naming the largest count and fraction of the charge.
+  positions) is within sqrt(3)/2 of its dx, a lattice cell's half-diagonal, and is
+  intact: not one of its bonds is broken (damage 0).  A point with a broken bond
+  borders a crack (a face of one planar crack has damage of about 0.3-0.45: it loses
+  the bonds across the plane), and gas may enter the rock through its cracks and
+  crushed zone, but not intact rock: there it has passed through the tube and the
+  wall.  Any point in intact rock makes the block an error naming the largest count
+  and fraction of the charge.
 """
 from __future__ import annotations
 
@@ -144,7 +146,7 @@ def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
     if len(ir) and len(yi):
         d, j = cKDTree(x[ir] + u[ir]).query(yi)
         near = d / (0.5 * np.sqrt(3.0) * h_rock[j])
-        intact = (run.field("damage", k)[ir[j]] < 0.5 if run.has_field("damage")
+        intact = (run.field("damage", k)[ir[j]] == 0.0 if run.has_field("damage")
                   else np.ones(len(yi), bool))
     # the nearest rock point over all ranks decides (ties: the lower rank)
     allnear = np.array(run.comm.allgather(near)).reshape(run.comm.Get_size(), -1)

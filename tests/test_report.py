@@ -80,7 +80,7 @@ def peak_values(x, part):
     return p, srr, speed
 
 
-def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5, legacy=False):
+def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5, legacy=False, faces=None):
     """An mpipd-layout run file.  ``failed``: boolean mask (last frame damage = 1);
     v = (v_rock * k, 0, 0) m/s and elastic energy w_rock * k J/m3 on the rock at frame k;
     explosive pressure 1e8 * (k + 1) * (1 + z/mm) Pa at the saved frames; probes carry a
@@ -110,6 +110,8 @@ def write_run(path, failed=None, v_rock=1.0, w_rock=2.0, frames=5, legacy=False)
         k = np.arange(frames)[:, None]
         dmg = np.zeros((frames, N))
         dmg[-1, failed] = 1.0
+        if faces is not None:                   # crack faces: a few bonds broken
+            dmg[-1, faces] = 0.3
         fl["damage"] = dmg
         fl["failure_mode"] = np.where(dmg > 0, 3.0, 0.0)
         v = np.zeros((frames, N, 3))
@@ -302,16 +304,18 @@ def test_sections_of_a_graded_rock_span_every_zone(tmp_path):
 
 def test_gas_inside_intact_rock_is_an_error(tmp_path):
     """Explosive points moved (u field) at frame 4 (the last; damage = 1 on the failed
-    mask there): 7 onto intact rock points at r ~ 10 mm (+0.3 dx off them), 5 onto
-    failed rock points (a crack: gas may be there), 2 to r = R_b + 0.4 dx (still at the
-    wall), 3 beyond R_o and 4 past the far face.  In the rock's volume: 12; inside
-    intact rock: 7, an error naming 7 points.  At rest: none."""
+    mask there, 0.3 on crack faces): 7 onto intact rock points at r ~ 10 mm (+0.3 dx
+    off them), 5 onto failed rock points and 3 onto crack-face points (a crack: gas
+    may be there), 2 to r = R_b + 0.4 dx (still at the wall), 3 beyond R_o and 4 past
+    the far face.  In the rock's volume: 15; inside intact rock: 7, an error naming
+    7 points.  At rest: none."""
     xs, part = lattice()
     rockpts = np.flatnonzero((part == 1) & (np.abs(np.hypot(xs[:, 0], xs[:, 1]) - 10e-3) < DX))
     crack = rockpts[::3][:5]
+    faces = rockpts[2::3][:3]
     failed = np.zeros(len(xs), bool)
     failed[crack] = True
-    x, part = write_run(tmp_path / "run.h5", failed=failed)
+    x, part = write_run(tmp_path / "run.h5", failed=failed, faces=faces)
     charge = np.flatnonzero(part == 0)
     with h5py.File(tmp_path / "run.h5", "r+") as f:
         f["fields/u"] = np.zeros((5, len(x), 3))
@@ -333,8 +337,10 @@ def test_gas_inside_intact_rock_is_an_error(tmp_path):
     intact = [t for t in rockpts[1::3] if not failed[t]][:7]
     u = np.zeros((5, len(x), 3))
     a, b, c, d, e = charge[:7], charge[7:12], charge[12:14], charge[14:17], charge[17:21]
+    w = charge[21:24]
     u[4, a] = onto(a, intact)
     u[4, b] = onto(b, crack)
+    u[4, w] = onto(w, faces)
     u[4, c] = to(c, R_WALL + 0.4 * DX)
     u[4, d] = to(d, R_OUT + 1e-3)
     u[4, e] = to(e, 10e-3, z=NZ * DX + 1e-3)
@@ -342,7 +348,7 @@ def test_gas_inside_intact_rock_is_an_error(tmp_path):
         f["fields/u"][...] = u
     m, _ = analyse(tmp_path / "run.h5")
     g = m["gas_containment"]
-    assert g["points_in_rock"] == [0, 0, 0, 0, 12]
+    assert g["points_in_rock"] == [0, 0, 0, 0, 15]
     assert g["points_in_intact_rock"] == [0, 0, 0, 0, 7]
     assert g["max_fraction_in_intact_rock"] == pytest.approx(7 / len(charge))
     assert "7 explosive points" in g["error"]
