@@ -106,7 +106,10 @@ class Model:
                 "rock_zones": [self.part_names[k] for k in self.rock_ids],
                 "wall_dx_m": self.wall_dx,
                 "charge_part": None if self.charge is None else self.part_names[self.charge],
-                "pressure_factor": self.pressure_factor, "overrides": self.overrides,
+                "pressure_factor": self.pressure_factor,
+                "gas_acts_on": (None if self.explosive is None
+                                else list(getattr(self.explosive, "interacts_with", ()))),
+                "overrides": self.overrides,
                 "notes": self.notes}
 
 

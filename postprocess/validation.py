@@ -196,6 +196,9 @@ def provenance(runs) -> list[str]:
         ("scene", lambda r: model(r, "scene") or "not in report.json"),
         ("overrides (--set)", lambda r: "<br>".join(f"`{o}`" for o in model(r, "overrides") or [])
          or "none"),
+        ("the gas acts on (interacts_with)",
+         lambda r: "not in report.json" if model(r, "gas_acts_on") is None
+         else ", ".join(model(r, "gas_acts_on")) or "nothing"),
         ("run file", lambda r: f"`{get(r, 'run_file')}`"),
         ("report.json", lambda r: f"`{r['input'].report_dir / 'report.json'}` → "
          f"`{r['md_dir']}/report.json`"),

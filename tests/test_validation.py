@@ -59,7 +59,8 @@ def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces"
                    "run_id": f"id-{case}", "n_bonds": 999, "save_every": 100},
            "errors": [], "figures": {f: f + ".png" for f in figures},
            "figures_not_made": {"fig18_ppv": "the run has no peak_speed field"},
-           "model": {"scene": "blast_demo", "dx_m": 0.001, "overrides": [], "notes": []},
+           "model": {"scene": "blast_demo", "dx_m": 0.001, "overrides": [], "notes": [],
+                     **({"gas_acts_on": ["copper", "granite"]} if case == "alpha" else {})},
            "frames": 7, "t_end_us": 12.0,
            "explosive_reference": {"consistency_MPa": list(CONSISTENCY)}, "targets": rows}
     if lattice_bias is not None:
@@ -150,6 +151,7 @@ def test_record(two_reports, capsys):
     prov = {r[0]: r[1:] for r in table(md, "## Provenance")}
     assert prov["points"] == ["12345", "12345"] and prov["ranks"] == ["3", "3"]
     assert prov["run id"] == ["id-alpha", "id-beta"]
+    assert prov["the gas acts on (interacts_with)"] == ["copper, granite", "not in report.json"]
     # alpha: 240 s over two invocations; 999 bonds x 600 steps / 240 s; per rank the
     # time-weighted mean of (999*200/60)/2 and (999*400/180)/3 (computed here)
     per_rank = ((999 * 200 / 60) / 2 * 60 + (999 * 400 / 180) / 3 * 180) / 240

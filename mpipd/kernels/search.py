@@ -3,7 +3,8 @@ mpipd.model.gas).
 
 The candidate points are binned into cubic cells of side ``cell`` (at least the
 largest cut-off), keyed (ix n_y + iy) n_z + iz and sorted by key; each row point
-scans the 27 cells around its own (binary search of the sorted keys), so the work
+scans the 27 cells around its own (binary search of the sorted keys; the three
+cells along z of each x-y column are one contiguous run), in one pass, so the work
 is O(points x neighbours) and no dense grid is held however far the gas spreads.
 A pair (i, j) is kept when i != j and |y_i - y_j| < max(h_i, h_j) + skin; each
 row is returned sorted by neighbour gid (the order every kernel sums in).
@@ -26,37 +27,41 @@ def cell_counts(y_el: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True)
-def _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, nbr, start, fill):
-    """Count (fill == False) or write (fill == True) each row's pairs."""
+def _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, cap):
+    """Each row's pairs in one pass, rows in order (so the result is CSR): the
+    neighbour list, grown by doubling from ``cap`` entries, and its length."""
     ny, nz = dims[1], dims[2]
+    nbr = np.empty(max(cap, 16), np.int32)
+    k = 0
     for q in range(rows.shape[0]):
         i = rows[q]
         cx = int((y[i, 0] - lo[0]) / cell)
         cy = int((y[i, 1] - lo[1]) / cell)
         cz = int((y[i, 2] - lo[2]) / cell)
-        k = start[i] if fill else 0
+        a0 = k
         for ax in range(max(cx - 1, 0), min(cx + 2, dims[0])):
             for ay in range(max(cy - 1, 0), min(cy + 2, ny)):
-                for az in range(max(cz - 1, 0), min(cz + 2, nz)):
-                    key = (ax * ny + ay) * nz + az
-                    a = np.searchsorted(skeys, key, "left")
-                    b = np.searchsorted(skeys, key, "right")
-                    for p in range(a, b):
-                        j = el[order[p]]
-                        if j == i:
-                            continue
-                        d0 = y[j, 0] - y[i, 0]
-                        d1 = y[j, 1] - y[i, 1]
-                        d2 = y[j, 2] - y[i, 2]
-                        r = max(h[i], h[j]) + skin
-                        if d0 * d0 + d1 * d1 + d2 * d2 < r * r:
-                            if fill:
-                                nbr[k] = j
-                                k += 1
-                            else:
-                                counts[i] += 1
-        if fill:
-            sort_row_by_gid(nbr, start[i], k, gid)
+                key0 = (ax * ny + ay) * nz
+                a = np.searchsorted(skeys, key0 + max(cz - 1, 0), "left")
+                b = np.searchsorted(skeys, key0 + min(cz + 1, nz - 1), "right")
+                for p in range(a, b):          # the (up to) 3 cells along z are contiguous
+                    j = el[order[p]]
+                    if j == i:
+                        continue
+                    d0 = y[j, 0] - y[i, 0]
+                    d1 = y[j, 1] - y[i, 1]
+                    d2 = y[j, 2] - y[i, 2]
+                    r = max(h[i], h[j]) + skin
+                    if d0 * d0 + d1 * d1 + d2 * d2 < r * r:
+                        if k == nbr.shape[0]:
+                            grown = np.empty(2 * k, np.int32)
+                            grown[:k] = nbr
+                            nbr = grown
+                        nbr[k] = j
+                        k += 1
+        counts[i] = k - a0
+        sort_row_by_gid(nbr, a0, k, gid)
+    return nbr, k
 
 
 @numba.njit(cache=True)
@@ -76,9 +81,12 @@ def sort_row_by_gid(nbr, a, b, gid):
 
 @numba.njit(cache=True)
 def cell_pairs(y, rows, el, h, skin, cell, lo, dims, gid, n_rows):
-    """Families of the points ``rows`` among the candidates ``el`` (local indices;
-    rows a subset of el) at positions ``y``: (row counts over n_rows, nbr), each row
-    sorted by gid.  ``lo`` and ``dims`` from :func:`cell_counts` of y[el]."""
+    """Families of the points ``rows`` (local indices, ascending) among the candidates
+    ``el`` (local indices) at positions ``y``: (row counts over n_rows, nbr), each
+    row sorted by gid.  ``lo`` and ``dims`` from :func:`cell_counts` of y[el]."""
+    for q in range(1, rows.shape[0]):
+        if rows[q] <= rows[q - 1]:
+            raise ValueError("cell_pairs: rows must be ascending")
     m = el.shape[0]
     keys = np.empty(m, np.int64)
     for p in range(m):
@@ -90,14 +98,9 @@ def cell_pairs(y, rows, el, h, skin, cell, lo, dims, gid, n_rows):
     order = np.argsort(keys)
     skeys = keys[order]
     counts = np.zeros(n_rows, np.int64)
-    start = np.zeros(n_rows + 1, np.int64)
-    empty = np.empty(0, np.int32)
-    _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, empty, start, False)
-    for r in range(n_rows):
-        start[r + 1] = start[r] + counts[r]
-    nbr = np.empty(start[n_rows], np.int32)
-    _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts, nbr, start, True)
-    return counts, nbr
+    nbr, k = _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, gid, counts,
+                   64 * rows.shape[0])
+    return counts, nbr[:k].copy()
 
 
 @numba.njit(cache=True)
