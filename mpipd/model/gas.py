@@ -217,28 +217,30 @@ class Gas(Model):
     def _pairs(self, ye, n):
         """The families at positions ``ye`` (local + remote rows): each owned gas point
         among every candidate (gas and solids), each owned solid among the gas only
-        (a solid-solid pair carries no force), solids farther than the reach from
-        the gas's bounding box skipped."""
+        (a solid-solid pair carries no force); solids outside the gas's bounding box
+        grown by the reach plus the skin cannot pair and are skipped."""
         el, gas = self.el_ext, self.gas_all
         if not len(self.rows) or not len(gas):
             self.offsets[:] = 0
             self.nbr = np.zeros(0, np.int32)
             return
         cell = self.reach + self.skin
-        lo, dims = cell_counts(ye[el], cell)
+        yg = ye[gas]
+        lo, hi = yg.min(axis=0) - cell, yg.max(axis=0) + cell
+
+        def near(idx):                      # within the gas's bounding box + the reach
+            yi = ye[idx]
+            return idx[np.all((yi >= lo) & (yi <= hi), axis=1)]
+        el = near(el)
+        lo_el, dims = cell_counts(ye[el], cell)
         if not float(np.prod(dims.astype(float))) < MAX_CELLS:   # too spread for int64 keys
             counts, self.nbr = self._tree_pairs(ye, n)
         else:
-            ca, na = cell_pairs(ye, self.gas_idx, el, self.h_ext, self.skin, cell, lo, dims,
+            ca, na = cell_pairs(ye, self.gas_idx, el, self.h_ext, self.skin, cell, lo_el, dims,
                                 self.gid_ext, n)
-            sol = self.solids_owned
-            yg = ye[gas]
-            ys = ye[sol]
-            near = np.all((ys >= yg.min(axis=0) - cell) & (ys <= yg.max(axis=0) + cell), axis=1)
-            sol = sol[near]
-            lo, dims = cell_counts(yg, cell)
-            cb, nb = cell_pairs(ye, sol, gas, self.h_ext, self.skin, cell, lo, dims,
-                                self.gid_ext, n)
+            lo_g, dims = cell_counts(yg, cell)
+            cb, nb = cell_pairs(ye, near(self.solids_owned), gas, self.h_ext, self.skin, cell,
+                                lo_g, dims, self.gid_ext, n)
             counts, self.nbr = merge_rows(ca, na, cb, nb)
         self.offsets[1:] = np.cumsum(counts)
 
