@@ -202,3 +202,13 @@ def test_multirate_identical_on_1_2_3_ranks(multirate_runs, fracture_runs):
                     np.testing.assert_allclose(f[k][...], ref[k], rtol=0, atol=1e-12)
                 else:
                     assert np.array_equal(f[k][...], ref[k]), f"{k} differs between 1 and {n} ranks"
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_remote_solids_are_exactly_those_the_gas_reaches(ranks):
+    """mpi_near_check.py: gas moved up to a column away from its owners' slabs; each
+    rank's remote solid rows are exactly the solids it lacks within the gas reach of
+    its own gas, with their owners' positions, velocities, volumes and gids."""
+    res = run_mpi_script(HERE / "mpi_near_check.py", ranks, timeout=180)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "near ok=True" in res.stdout
