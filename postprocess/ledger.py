@@ -9,7 +9,9 @@ total, external, hourglass), gives the final value of each and the largest
 |balance|.  A term that must be non-negative (``mpipd.model.ledger.NON_NEGATIVE``) going
 below -BALANCE_TOL (1e-3) of the ledger's scale (the largest magnitude of any J
 term at any frame; the solver's own check uses the same tolerance) is an error: it
-is reported as such and its values are not shown as numbers.
+is reported as such and its values are not shown as numbers.  A ``balance`` beyond
+the same bound (1e-3: healthy runs close to 2.5e-4 at the paper's geometry and to
+5e-5 in blast_demo) at any frame is an error too: the books do not close.
 """
 from __future__ import annotations
 
@@ -52,6 +54,15 @@ def read(run) -> dict:
         out["balance"] = b.tolist()
         out["max_abs_balance"] = float(abs(b[k])) if ok else None
         out["max_abs_balance_frame"] = k
+        first = np.flatnonzero(~(np.abs(b) <= TOL))            # beyond the bound, or NaN
+        if len(first):
+            f = int(first[0])
+            errors.append({"measure": "energy ledger: closure",
+                           "message": f"the ledger does not close: |balance| = "
+                                      f"{abs(b[f]):.3g} at frame {f} (largest "
+                                      f"{out['max_abs_balance']:.3g} at frame {k}), above "
+                                      f"the bound {TOL:g}: energy was created or lost "
+                                      "unbooked"})
     else:
         out["max_abs_balance"] = None
     return out

@@ -792,9 +792,9 @@ def test_probe_outside_its_part_is_an_error(tmp_path):
 
 
 def test_negative_energies_are_errors(tmp_path):
-    """A negative kinetic term of the ledger and a negative elastic energy in the rock
-    (larger than its kinetic energy) are errors; the other ledger terms and the largest
-    |balance| are reported."""
+    """A negative kinetic term of the ledger, a negative elastic energy in the rock
+    (larger than its kinetic energy) and a balance beyond 1e-3 are errors; the other
+    ledger terms and the largest |balance| are reported."""
     from mpi4py import MPI
 
     from postprocess.report import make_report
@@ -813,7 +813,16 @@ def test_negative_energies_are_errors(tmp_path):
     assert led["max_abs_balance"] == pytest.approx(3e-3) and led["max_abs_balance_frame"] == 2
     assert "kinetic" not in led["series_J"]
     assert sorted(e["measure"] for e in m["errors"]) == ["energy in the rock (Fig. 20)",
+                                                         "energy ledger: closure",
                                                          "energy ledger: kinetic"]
+    closure = [e for e in m["errors"] if e["measure"] == "energy ledger: closure"][0]
+    assert "|balance| = 0.003 at frame 2" in closure["message"]
+    with h5py.File(path, "r+") as f:                    # within the bound: no error
+        f["energy"]["balance"][...] = [0.0, 1e-4, -9e-4, 2e-4, 1e-3]
+    m, _ = analyse(path)
+    assert "energy ledger: closure" not in [e["measure"] for e in m["errors"]]
+    with h5py.File(path, "r+") as f:
+        f["energy"]["balance"][...] = [0.0, 1e-4, -3e-3, 2e-3, 1e-3]
     make_report(path, tmp_path / "rep", MPI.COMM_SELF)
     md = (tmp_path / "rep" / "report.md").read_text()
     assert "| kinetic | **error**" in md and "| elastic | 4 |" in md
