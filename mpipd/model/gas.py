@@ -159,13 +159,13 @@ class Gas(Model):
         add("gas_vr_lit", own, self.vr_lit, rows=self.gas_idx, checkpoint=True)
         add("gas_is_gas", own, self.is_gas, rows=LOCAL)
         add("gas_horizon", own, self.gas_horizon, rows=LOCAL)
-        for name in ("eligible", "rows", "gas_idx", "watch", "solids_owned"):
-            add(f"gas_{name}" if name != "gas_idx" else name, own, getattr(self, name),
-                rows=AUX)
+        for name in ("eligible", "rows", "gas_idx", "gas_all", "watch", "solids_owned"):
+            add(f"gas_{name}" if name not in ("gas_idx", "gas_all") else name, own,
+                getattr(self, name), rows=AUX)
         add("gas_offsets", own, get=lambda: self.offsets, rows=AUX)
         add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
-        for name in ("y_ext", "v_ext", "isgas_ext", "h_ext", "el_ext"):
+        for name in ("y_ext", "v_ext", "vol_ext", "gid_ext", "isgas_ext", "h_ext", "el_ext"):
             add(f"gas_{name}", own, get=lambda name=name: getattr(self, name), rows=AUX)
         add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
         if self.viscous:
