@@ -54,7 +54,7 @@ FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touche
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
 VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 72   # fd columns; dilatation, viscous force (2 steps)
 JH2_OWNED = 40                  # D, eps_p, dp, pressure, strain rate
-GAS_LOCAL, GAS_OWNED = 147, 32  # gas force data (8), flags, gas horizon, pair weights (2 steps),
+GAS_LOCAL, GAS_OWNED = 171, 32  # gas force data (8), flags, gas horizon, pair weights (2 steps), x + u,
 #                                 the kernels' positions, velocities, flags and horizons over
 #                                 local + remote rows; UL offsets, V ratio, damping, the
 #                                 ledger's damping energy

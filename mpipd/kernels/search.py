@@ -19,6 +19,14 @@ import numpy as np
 MAX_CELLS = 1 << 62
 
 
+def in_box(y: np.ndarray, idx: np.ndarray, around: np.ndarray, reach: float) -> np.ndarray:
+    """The points ``idx`` whose positions y lie in the bounding box of the points
+    ``around`` (positions) grown by ``reach``: no point outside it is within reach."""
+    lo, hi = around.min(axis=0) - reach, around.max(axis=0) + reach
+    yi = y[idx]
+    return idx[np.all((yi >= lo) & (yi <= hi), axis=1)]
+
+
 def cell_counts(y_el: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
     """Lower corner and cells per axis of the candidates' bounding box."""
     lo = y_el.min(axis=0)

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
-from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows
+from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, in_box, max_moved2, merge_rows
 from ..kernels.ul import gas_gather, gas_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
@@ -118,6 +118,7 @@ class Gas(Model):
         if slabs is not None and team.size > 1 and len(acts):
             self.near = _near_halo(team.comm, slabs, p, self.solids_owned, gas_all)
         self._extend(0)
+        self._y = np.zeros((nl, 3))              # x + u of the local points, this step
         self.y = None                            # current positions (y_ext) of the last update
 
     def _extend(self, n_remote: int):
@@ -165,6 +166,7 @@ class Gas(Model):
         add("gas_offsets", own, get=lambda: self.offsets, rows=AUX)
         add("gas_nbr", own, get=lambda: self.nbr, rows=AUX)
         add("gas_y_built", own, get=lambda: self.y_built, rows=AUX)
+        add("gas_y_local", own, self._y, rows=LOCAL)
         for name in ("y_ext", "v_ext", "vol_ext", "gid_ext", "isgas_ext", "h_ext", "el_ext"):
             add(f"gas_{name}", own, get=lambda name=name: getattr(self, name), rows=AUX)
         add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
@@ -226,12 +228,7 @@ class Gas(Model):
             return
         cell = self.reach + self.skin
         yg = ye[gas]
-        lo, hi = yg.min(axis=0) - cell, yg.max(axis=0) + cell
-
-        def near(idx):                      # within the gas's bounding box + the reach
-            yi = ye[idx]
-            return idx[np.all((yi >= lo) & (yi <= hi), axis=1)]
-        el = near(el)
+        el = in_box(ye, el, yg, cell)
         lo_el, dims = cell_counts(ye[el], cell)
         if not float(np.prod(dims.astype(float))) < MAX_CELLS:   # too spread for int64 keys
             counts, self.nbr = self._tree_pairs(ye, n)
@@ -239,8 +236,8 @@ class Gas(Model):
             ca, na = cell_pairs(ye, self.gas_idx, el, self.h_ext, self.skin, cell, lo_el, dims,
                                 self.gid_ext, n)
             lo_g, dims = cell_counts(yg, cell)
-            cb, nb = cell_pairs(ye, near(self.solids_owned), gas, self.h_ext, self.skin, cell,
-                                lo_g, dims, self.gid_ext, n)
+            cb, nb = cell_pairs(ye, in_box(ye, self.solids_owned, yg, cell), gas, self.h_ext,
+                                self.skin, cell, lo_g, dims, self.gid_ext, n)
             counts, self.nbr = merge_rows(ca, na, cb, nb)
         self.offsets[1:] = np.cumsum(counts)
 
@@ -258,7 +255,8 @@ class Gas(Model):
     def update(self, u, v, dt: float, t: float):
         """Families, then volume, energy, pressure and force data of the owned gas."""
         p, m = self.points, self.mat
-        self.search(p.x + u, v)
+        np.add(p.x, u, out=self._y)
+        self.search(self._y, v)
         y = self.y = self.y_ext                 # current positions, kept for gather()
         self.V_pw[:] = self.V_w                 # in place: the State holds these arrays
         self.V_w[:] = self.gd[:, GD_V]

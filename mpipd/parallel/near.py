@@ -25,6 +25,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..kernels.search import in_box
+
 
 class NearHalo:
     def __init__(self, comm, n_local: int, sources: np.ndarray, lacks: dict[int, np.ndarray],
@@ -56,9 +58,7 @@ class NearHalo:
         if not len(cand) or not len(g):
             return np.zeros(0, np.int64)
         yg = y[g]
-        lo, hi = yg.min(axis=0) - reach, yg.max(axis=0) + reach
-        yc = y[cand]
-        cand = cand[np.all((yc >= lo) & (yc <= hi), axis=1)]
+        cand = in_box(y, cand, yg, reach)
         if not len(cand):
             return cand
         d, _ = cKDTree(yg).query(y[cand], distance_upper_bound=reach)
