@@ -319,6 +319,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             f"{k} max {v['max']:.3f}, mean {v['mean']:.3f}"
             + (f", {v['lit_fraction']:.0%} lit" if v["lit_fraction"] < 1 else "")
             for k, v in lit.items()))
+        off, n_gas = (team.sum(int(sim.gas.n_singular)), team.sum(len(sim.gas.gas_idx)))
+        log(f"mpipd: gas points carrying no force at the end (no gas neighbourhood, "
+            f"mpipd.kernels.ul.well_posed): {off} of {n_gas}")
     if sim.probes is not None:
         for name, (srr, vr, pmax) in sim.probes.peaks().items():
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "

@@ -490,3 +490,79 @@ def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
     assert off[-1] == sum(len(v) for v in want.values()) > 0
     for i in range(n):
         assert list(n2[off[i]:off[i + 1]]) == want.get(i, [])
+
+
+# ------------------------------------------------------------------ where the gas acts
+def _lattice_update(gas_mask, a=2.0e5, h=4.0e-4):
+    """One gas_update on a 7 x 7 x 7 cubic lattice (spacing h, gas horizon 3h) under
+    the affine compression v = -a x, every listed gas point lit at its loaded density:
+    returns (gd, e, n_bad, gas_idx, centre index)."""
+    from mpipd.kernels.ul import gas_update
+    g = (np.arange(7) - 3) * h
+    x = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    n = len(x)
+    is_gas = gas_mask(x).astype(np.uint8)
+    gas_idx = np.flatnonzero(is_gas).astype(np.int64)
+    delta = np.where(is_gas > 0, 3.0 * h, 0.0)
+    d = np.linalg.norm(x[:, None] - x[None], axis=-1)
+    near = (d < 3.3 * h) & ~np.eye(n, dtype=bool)
+    offsets = np.concatenate(([0], np.cumsum(near.sum(1)))).astype(np.int64)
+    nbr = np.nonzero(near)[1].astype(np.int32)
+    V = np.full(n, h ** 3)
+    gd = np.zeros((n, 8))
+    gd[:, 6] = V
+    e = np.full(len(gas_idx), 7.38e9)
+    dt = 2.0e-8
+    n_bad, _ = gas_update(gas_idx, x.copy(), -a * x, V, V.copy(), V.copy(), gd, delta, offsets,
+                          nbr, dt, 1.0, np.zeros(len(gas_idx)), 0.0, V[gas_idx].copy(), e,
+                          568e9, 21.6e9, 5.81, 1.77, 0.282, 1.0, is_gas,
+                          np.zeros(len(gas_idx)), np.zeros(len(gas_idx)))
+    centre = int(np.flatnonzero(np.all(x == 0.0, axis=1))[0])
+    return gd, e, n_bad, gas_idx, centre, x, dt
+
+
+@pytest.mark.parametrize("where, acts", [
+    ("block", True),            # all gas: the interior point measures tr L = -3a
+    ("wall", True),             # gas for z <= 0, solid above: the wall's motion counts
+    ("slab", True),             # three gas layers among solid: still a volume of gas
+    ("lone", False),            # one gas point among solid points
+    ("sheet", False),           # one gas layer (z = 0) among solid: coplanar gas
+    ("line", False),            # a row of gas along x among solid
+])
+def test_a_gas_point_acts_only_among_gas(where, acts):
+    """A gas point carries pressure where its gas neighbours span a volume: the affine
+    field gives tr L = -3a at a full family, so V_R = exp(-3a dt) and p = JWL(V_R, e)
+    with e from the trapezoidal work, and the force state -p M^-1 (M over the whole
+    family, computed here directly).  A point whose gas neighbours lie on a plane or a
+    line, or that has none, carries no force and keeps its volume and energy."""
+    masks = {"block": lambda x: np.ones(len(x), bool),
+             "wall": lambda x: x[:, 2] <= 0.0,
+             "slab": lambda x: np.abs(x[:, 2]) < 1.5 * 4.0e-4,
+             "lone": lambda x: np.all(x == 0.0, axis=1),
+             "sheet": lambda x: x[:, 2] == 0.0,
+             "line": lambda x: (x[:, 1] == 0.0) & (x[:, 2] == 0.0)}
+    a, h = 2.0e5, 4.0e-4
+    gd, e, n_bad, gas_idx, c, x, dt = _lattice_update(masks[where], a, h)
+    k = int(np.flatnonzero(gas_idx == c)[0])
+    V0 = h ** 3
+    if not acts:
+        assert np.all(gd[c, :6] == 0.0) and gd[c, 6] == V0
+        assert e[k] == 7.38e9
+        assert n_bad >= 1
+        return
+    VR = math.exp(-3.0 * a * dt)
+    np.testing.assert_allclose(gd[c, 6] / V0, VR, rtol=1e-9)
+    A, B, R1, R2, w = 568e9, 21.6e9, 5.81, 1.77, 0.282
+    f = A * (1 - w / (R1 * VR)) * math.exp(-R1 * VR) + B * (1 - w / (R2 * VR)) * math.exp(-R2 * VR)
+    b = V0 * (-3.0 * a) * dt                    # V_w tr L dt
+    e_want = (7.38e9 * V0 - 0.5 * f * b) / (V0 + 0.5 * w * b / VR)
+    p = f + w * e_want / VR
+    np.testing.assert_allclose(e[k], e_want, rtol=1e-12)
+    np.testing.assert_allclose(gd[c, 7], p, rtol=1e-12)
+    Y = x - x[c]
+    ly = np.linalg.norm(Y, axis=1)
+    wgt = np.where(ly < 3.0 * h, (3.0 * h - ly) ** 2, 0.0) * h ** 3
+    wgt[c] = 0.0
+    Mi = np.linalg.inv((Y * wgt[:, None]).T @ Y)
+    want = -p * Mi[[0, 1, 2, 1, 0, 0], [0, 1, 2, 2, 2, 1]]
+    np.testing.assert_allclose(gd[c, :6], want, rtol=1e-9, atol=1e-9 * np.abs(want).max())

@@ -26,6 +26,19 @@ The energy equation below takes the work of the p part only; the work of the q p
 (of the same trapezoid, split in proportion p : q, which is exact because the force
 is linear in A) is dissipated, -W_q >= 0, and returned (the ledger's ``gas_viscous``).
 
+Where the gas acts.  A gas point carries a pressure force only where its current
+family is a gas neighbourhood (:func:`well_posed`): at least MIN_NEIGHBOURS
+neighbours whose second moment M spans a volume, and the same of its gas neighbours
+alone, M_g = sum over gas j of omega Y (x) Y V_j.  The solid neighbours give a gas
+point at the edge of the gas the motion of the wall; a lone gas point carried in
+among solid points (into a crack, below what the lattice resolves) would take the
+solid's deformation for its own volume change, and the rock, stiff and nearly
+incompressible, would hold it near the detonation pressure, an explosive inclusion
+that pushes the rock apart from inside (issue 15: such points at V_R 0.1-0.3 and
+67-113 GPa in the contained blast_paper:dx1.2 run, whose energy balance then failed).
+Such a point carries no force, its volume and energy stay as they are (its energy
+is held: the ledger's ``gas``), and it acts again once it is among gas.
+
 Energy.  The internal energy changes by exactly the trapezoidal work of the
 point's own force state (what the energy ledger books for every force, the
 "compatible" energy update of Owen 2014 for SPH).  Pair weights are the
@@ -58,7 +71,8 @@ from ..materials.jwl import jwl_cold, jwl_sound_speed2, unreacted_pressure, unre
 from .layout import GD_P, GD_V
 from .linalg import det3, inv3
 
-#: fewest current neighbours, and smallest det M / (tr M / 3)^3, for a gas point to act
+#: fewest current neighbours, and smallest det M / (tr M / 3)^3, for a gas point to act;
+#: both hold for its whole family and for its gas neighbours alone (gas_update)
 MIN_NEIGHBOURS = 6
 RCOND_M = 1e-3
 
@@ -70,6 +84,14 @@ def current_bond(y, i, j):
     y1 = y[j, 1] - y[i, 1]
     y2 = y[j, 2] - y[i, 2]
     return y0, y1, y2, math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+
+
+@numba.njit(cache=True)
+def well_posed(M, nb):
+    """Does a second-moment tensor M of ``nb`` bonds span a volume: nb >= MIN_NEIGHBOURS
+    and det M > RCOND_M (tr M / 3)^3 (1 for an isotropic family, 0 for a plane)?"""
+    tr = M[0, 0] + M[1, 1] + M[2, 2]
+    return nb >= MIN_NEIGHBOURS and det3(M) > RCOND_M * (tr / 3.0) ** 3
 
 
 @numba.njit(cache=True)
@@ -88,6 +110,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
     viscosity's coefficients.  K_u, s_u, a_u: the unreacted EOS
     (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
     M = np.empty((3, 3))
+    Mg = np.empty((3, 3))
     Mi = np.empty((3, 3))
     N = np.empty((3, 3))
     n_bad = 0
@@ -98,8 +121,10 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         for r in range(3):
             for c in range(3):
                 M[r, c] = 0.0
+                Mg[r, c] = 0.0
                 N[r, c] = 0.0
         nb = 0
+        ng = 0
         wa = 0.0                                # -A^n : sum omega V dt Ydot (x) Y^n
         a0, a1, a2 = gd[i, 0], gd[i, 1], gd[i, 2]
         a3, a4, a5 = gd[i, 3], gd[i, 4], gd[i, 5]
@@ -139,6 +164,14 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             N[2, 1] += wgt * z2 * y1
             N[2, 2] += wgt * z2 * y2
             nb += 1
+            if is_gas[j]:
+                Mg[0, 0] += wgt * y0 * y0
+                Mg[0, 1] += wgt * y0 * y1
+                Mg[0, 2] += wgt * y0 * y2
+                Mg[1, 1] += wgt * y1 * y1
+                Mg[1, 2] += wgt * y1 * y2
+                Mg[2, 2] += wgt * y2 * y2
+                ng += 1
         W_a = wa * V_pw[i] * dt                  # of the last force, A^n = -(p^n + q^n) M^-1
         ptot = gd[i, GD_P] + gq[k]
         W_aq = W_a * gq[k] / ptot if ptot != 0.0 else 0.0
@@ -146,11 +179,13 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         M[1, 0] = M[0, 1]
         M[2, 0] = M[0, 2]
         M[2, 1] = M[1, 2]
-        tr = M[0, 0] + M[1, 1] + M[2, 2]
-        det = det3(M)
-        # a gas point that has lost its neighbourhood (escaped through a crack, or
-        # with neighbours nearly coplanar) carries no pressure force
-        singular = nb < MIN_NEIGHBOURS or not det > RCOND_M * (tr / 3.0) ** 3
+        Mg[1, 0] = Mg[0, 1]
+        Mg[2, 0] = Mg[0, 2]
+        Mg[2, 1] = Mg[1, 2]
+        # a gas point that has lost its neighbourhood (escaped, or with neighbours
+        # nearly coplanar), or whose gas neighbours alone do not span a volume (a lone
+        # point carried into a crack among solid points) carries no pressure force
+        singular = (not well_posed(M, nb) or not well_posed(Mg, ng))
         trL = 0.0
         if not singular:
             inv3(M, Mi)
