@@ -65,6 +65,7 @@ OUTPUT_FIELDS = {
     "failure_mode": (1, "failure"),      # 0 intact, 1 JH2 D >= 1, 2 JH2 p* < -T*, 3 tension model
     "jh2_damage": (1, "jh2"), "pressure": (1, "pressure"), "plastic_strain": (1, "plastic"),
     "strain_rate": (1, "jh2"),
+    "gas_force": (1, "gas"),             # 1 where a gas point carried a force (kernels.ul.well_posed)
 }
 
 
@@ -386,13 +387,14 @@ class Scene:
                                 f"(got {n}): states are all current only at coarse steps")
         needs = {"failure": self.can_fail, "jh2": self.has_model("jh2"),
                  "plastic": self.has_model("jh2") or self.has_model("j2"),
-                 "pressure": self.has_model("jh2") or self.has_model("jwl")}
+                 "pressure": self.has_model("jh2") or self.has_model("jwl"),
+                 "gas": self.has_model("jwl")}
         for i, f in enumerate(self.output.fields):
             need = OUTPUT_FIELDS[f][1]
             if need is not None and not needs[need]:
                 what = {"failure": "a material that can fail (jh2, or a tension model)",
                     "jh2": "a jh2 material", "plastic": "a jh2 or j2 material",
-                    "pressure": "a jh2 or jwl material"}[need]
+                    "pressure": "a jh2 or jwl material", "gas": "a jwl material"}[need]
                 fail(f"output.fields[{i}]", f"{f!r} needs {what}")
 
     @property

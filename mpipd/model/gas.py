@@ -174,6 +174,7 @@ class Gas(Model):
             state.scalar("gas_viscous_work", own, lambda: self.viscous_work,
                          lambda v: setattr(self, "viscous_work", float(v)))
         state.offer("pressure", own, self.pressure)
+        state.offer("gas_force", own, self.carries_force)
         # the every-step peak, whole run (a restart goes on from it)
         state.scalar("gas_peak_pressure", own, lambda: self.peak_pressure,
                      lambda v: setattr(self, "peak_pressure", float(v)), reduce="max")
@@ -307,6 +308,13 @@ class Gas(Model):
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""
         return float(np.dot(self.e, self.V0))
+
+    def carries_force(self) -> np.ndarray:
+        """1 at the owned gas points whose force state is not zero after the last update
+        (lit, and with a gas neighbourhood: mpipd.kernels.ul.well_posed), 0 elsewhere."""
+        out = np.zeros(self.points.n_owned)
+        out[self.gas_idx] = np.any(self.gd[self.gas_idx, GD_A:GD_V] != 0.0, axis=1)
+        return out
 
     def pressure(self) -> np.ndarray:
         """Gas pressure over all owned points (0 elsewhere)."""
