@@ -88,7 +88,8 @@ def render(doc) -> str:
     L += _fig(doc, "fig13_failure_modes")
     L += _fracture(doc["fracture"]) + _fig(doc, "fig12_crack_density")
     L += _lattice_bias(doc["lattice_bias"])
-    L += _probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _energy(doc)
+    L += _probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _containment(doc)
+    L += _energy(doc)
     na = [f"- {r['label']}: {r['verdict'][len('not available: '):]}" for r in doc["targets"]
           if r["verdict"].startswith("not available")]
     na += [f"- figure {k}: {v}" for k, v in doc["figures_not_made"].items()]
@@ -298,6 +299,24 @@ def _pressure(doc) -> list[str]:
         L += [f"Wall layer: {ws['points']} rock points with r < R_b + dx; mean over the layer of "
               f"the per-point peak −σ_rr {ws['layer_mean_MPa']:.4g} MPa.", ""]
     return L + _fig(doc, "fig07_explosive_pressure") + _fig(doc, "fig07_pressure_plane")
+
+
+def _containment(doc) -> list[str]:
+    g = doc.get("gas_containment")
+    if g is None or _na(g):
+        return []
+    n = max(g["charge_points"], 1)
+    ir, ii = max(g["points_in_rock"]), max(g["points_in_intact_rock"])
+    pas = g.get("passive_in_intact_rock")
+    L = ["### Gas containment", "",
+         f"Explosive points inside the rock's volume (cracks and crushed zone included): at "
+         f"most {ir} ({100 * ir / n:.3g} % of the charge's {g['charge_points']}); inside "
+         f"intact rock and acting on it: at most {ii}"
+         + (f" ({g['max_at_us']:.3g} µs)" if ii else "") + "; "
+         + ("the run has no `gas_force` field, so every point there counts as acting."
+            if pas is None else f"passive there (no gas neighbourhood, no force): at most "
+            f"{max(pas)}."), ""]
+    return L
 
 
 def _energy(doc) -> list[str]:

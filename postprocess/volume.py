@@ -26,8 +26,12 @@ rank reads one frame of one field of its own slice at a time).
   borders a crack (a face of one planar crack has damage of about 0.3-0.45: it loses
   the bonds across the plane), and gas may enter the rock through its cracks and
   crushed zone, but not intact rock: there it has passed through the tube and the
-  wall.  Any point in intact rock makes the block an error naming the largest count
-  and fraction of the charge.
+  wall.  With the ``gas_force`` field (1 where a gas point carried a force at the
+  step: mpipd.kernels.ul.well_posed), the points in intact rock are split into those
+  that act on it and the passive ones, lone points with no gas neighbourhood that
+  carry no force and coast; without it every point counts as acting.  Any acting
+  point in intact rock makes the block an error naming the largest count and
+  fraction of the charge; passive ones are counted beside it.
 """
 from __future__ import annotations
 
@@ -68,6 +72,8 @@ def scan(run, model, profile_frames) -> dict:
     ig = np.flatnonzero(gas)
     in_rock = np.zeros(nf, np.int64)
     in_intact = np.zeros(nf, np.int64)
+    passive = np.zeros(nf, np.int64)
+    has_force = run.has_field("gas_force")
     zdx = np.zeros(int(pid.max()) + 1 if len(pid) else 1)
     for q in model.zone_ids:
         if q < len(zdx):
@@ -76,7 +82,8 @@ def scan(run, model, profile_frames) -> dict:
     prof = {}
     for k in range(nf):
         if has_u:
-            in_rock[k], in_intact[k] = _gas_in_rock(run, model, x, ig, rock, h_rock, k)
+            in_rock[k], in_intact[k], passive[k] = _gas_in_rock(run, model, x, ig, rock,
+                                                                h_rock, k, has_force)
         if has_v and rock_rho_known:
             v = run.field("v", k)
             ek[:, k] = run.per_level(np.where(rock, 0.5 * vol * rho * (v ** 2).sum(1), 0.0))
@@ -125,17 +132,20 @@ def scan(run, model, profile_frames) -> dict:
                                         "p_MPa": (a[ok, 0] / a[ok, 1] / 1e6).tolist()})
     out["failure_modes"] = _failure_modes(run, rock)
     out["gas_containment"] = (_containment(in_rock, in_intact, run.sum_int(int(gas.sum())),
-                                           run.time)
+                                           run.time, passive if has_force else None)
                               if has_u else {"not_available": "no u field or no explosive"})
     return out
 
 
-def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
-    """Frame k: the explosive's points inside the rock's volume, and inside intact rock
-    (module docstring); collective (every rank gets both counts)."""
+def _gas_in_rock(run, model, x, ig, rock, h_rock, k, has_force) -> tuple[int, int, int]:
+    """Frame k: the explosive's points inside the rock's volume, those inside intact
+    rock that act on it, and the passive ones there (module docstring); collective
+    (every rank gets the counts)."""
     from scipy.spatial import cKDTree
     u = run.field("u", k)                               # this rank's slice, read once
     y = np.concatenate(run.comm.allgather(x[ig] + u[ig]))           # every gas point, on every rank
+    acts = (np.concatenate(run.comm.allgather(run.field("gas_force", k)[ig] > 0.0))
+            if has_force else np.ones(len(y), bool))
     ry = model.radius(y)
     inside = ((ry > model.r_wall + 0.5 * model.wall_dx) & (ry < model.r_out)
               & (y[:, 2] > model.z0) & (y[:, 2] < model.z1))
@@ -154,14 +164,19 @@ def _gas_in_rock(run, model, x, ig, rock, h_rock, k) -> tuple[int, int]:
     best = np.argmin(allnear, axis=0) if len(yi) else np.zeros(0, int)
     cols = np.arange(len(yi))
     hit = (allnear[best, cols] < 1.0) & allint[best, cols]
-    return int(inside.sum()), int(np.count_nonzero(hit))
+    act = acts[inside]
+    return (int(inside.sum()), int(np.count_nonzero(hit & act)),
+            int(np.count_nonzero(hit & ~act)))
 
 
-def _containment(in_rock: np.ndarray, in_intact: np.ndarray, n_gas: int, times) -> dict:
-    """Per frame, the explosive's points inside the rock and inside intact rock."""
+def _containment(in_rock: np.ndarray, in_intact: np.ndarray, n_gas: int, times,
+                 passive: np.ndarray | None = None) -> dict:
+    """Per frame, the explosive's points inside the rock and inside intact rock (those
+    acting on it; ``passive``: those carrying no force, when the run says which)."""
     k = int(np.argmax(in_intact))
     out = {"t_us": [float(t) * 1e6 for t in times], "points_in_rock": in_rock.tolist(),
            "points_in_intact_rock": in_intact.tolist(), "charge_points": int(n_gas),
+           "passive_in_intact_rock": passive.tolist() if passive is not None else None,
            "max_fraction_in_rock": float(in_rock.max()) / max(n_gas, 1),
            "max_fraction_in_intact_rock": float(in_intact[k]) / max(n_gas, 1),
            "max_at_us": float(times[k]) * 1e6}

@@ -353,6 +353,26 @@ def test_gas_inside_intact_rock_is_an_error(tmp_path):
     assert g["max_fraction_in_intact_rock"] == pytest.approx(7 / len(charge))
     assert "7 explosive points" in g["error"]
     assert any(e["measure"] == "gas containment" for e in m["errors"])
+    assert g["passive_in_intact_rock"] is None               # the run does not say which act
+    # with the gas_force field: 3 of the 7 carry no force (lone, passive) and are
+    # counted apart; the 4 that act are the error; all 7 passive: no error
+    force = np.ones((5, len(x)))
+    force[4, a[:3]] = 0.0
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/gas_force"] = force
+    m, _ = analyse(tmp_path / "run.h5")
+    g = m["gas_containment"]
+    assert g["points_in_rock"] == [0, 0, 0, 0, 15]
+    assert g["points_in_intact_rock"] == [0, 0, 0, 0, 4]
+    assert g["passive_in_intact_rock"] == [0, 0, 0, 0, 3]
+    assert "4 explosive points" in g["error"]
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/gas_force"][4, a] = 0.0
+    m, _ = analyse(tmp_path / "run.h5")
+    g = m["gas_containment"]
+    assert g["points_in_intact_rock"] == [0] * 5 and g["passive_in_intact_rock"][4] == 7
+    assert "error" not in g
+    assert not any(e["measure"] == "gas containment" for e in m["errors"])
 
 
 def test_radial_cracks_and_crushed_zone(tmp_path):
