@@ -86,6 +86,17 @@ def current_bond(y, i, j):
     return y0, y1, y2, math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
 
 
+@numba.njit(cache=True, inline="always")
+def add_moment(M, wgt, y0, y1, y2):
+    """M += wgt Y (x) Y, upper triangle (the caller mirrors it)."""
+    M[0, 0] += wgt * y0 * y0
+    M[0, 1] += wgt * y0 * y1
+    M[0, 2] += wgt * y0 * y2
+    M[1, 1] += wgt * y1 * y1
+    M[1, 2] += wgt * y1 * y2
+    M[2, 2] += wgt * y2 * y2
+
+
 @numba.njit(cache=True)
 def well_posed(M, nb):
     """Does a second-moment tensor M of ``nb`` bonds span a volume: nb >= MIN_NEIGHBOURS
@@ -148,12 +159,7 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             if ly >= di:
                 continue
             wgt = (di - ly) * (di - ly) * (V_w[j] if is_gas[j] else V_ref[j])
-            M[0, 0] += wgt * y0 * y0
-            M[0, 1] += wgt * y0 * y1
-            M[0, 2] += wgt * y0 * y2
-            M[1, 1] += wgt * y1 * y1
-            M[1, 2] += wgt * y1 * y2
-            M[2, 2] += wgt * y2 * y2
+            add_moment(M, wgt, y0, y1, y2)
             N[0, 0] += wgt * z0 * y0
             N[0, 1] += wgt * z0 * y1
             N[0, 2] += wgt * z0 * y2
@@ -165,23 +171,15 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
             N[2, 2] += wgt * z2 * y2
             nb += 1
             if is_gas[j]:
-                Mg[0, 0] += wgt * y0 * y0
-                Mg[0, 1] += wgt * y0 * y1
-                Mg[0, 2] += wgt * y0 * y2
-                Mg[1, 1] += wgt * y1 * y1
-                Mg[1, 2] += wgt * y1 * y2
-                Mg[2, 2] += wgt * y2 * y2
+                add_moment(Mg, wgt, y0, y1, y2)
                 ng += 1
         W_a = wa * V_pw[i] * dt                  # of the last force, A^n = -(p^n + q^n) M^-1
         ptot = gd[i, GD_P] + gq[k]
         W_aq = W_a * gq[k] / ptot if ptot != 0.0 else 0.0
         W_a -= W_aq                             # its p part (the energy equation's)
-        M[1, 0] = M[0, 1]
-        M[2, 0] = M[0, 2]
-        M[2, 1] = M[1, 2]
-        Mg[1, 0] = Mg[0, 1]
-        Mg[2, 0] = Mg[0, 2]
-        Mg[2, 1] = Mg[1, 2]
+        for r, c in ((1, 0), (2, 0), (2, 1)):
+            M[r, c] = M[c, r]
+            Mg[r, c] = Mg[c, r]
         # a gas point that has lost its neighbourhood (escaped, or with neighbours
         # nearly coplanar), or whose gas neighbours alone do not span a volume (a lone
         # point carried into a crack among solid points) carries no pressure force
