@@ -14,7 +14,7 @@
 # blast_paper_dx1.2_rockmass_mr4 (b820a4a): mpirun -n 2 mpipd run blast_paper:rockmass --set parts.2.dx=1.2e-3
 #   --set 'scene.name="blast_paper-dx1.2-rockmass"' --set 'time.multirate={max_ratio=4,safety=0.5}'
 #   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_dx1.2_rockmass_mr4
-# blast_paper_dx1.2_contained (8ad176e; the gas acts on the granite too, the scene's default
+# blast_paper_dx1.2_contained (922369c, after the gas-neighbourhood rule of notes §12; the gas acts on the granite too, the scene's default
 #   since then): mpirun -n 2 mpipd run blast_paper:dx1.2 --set output.every=200
 #   --set output.checkpoint_every=500 --out runs/blast_paper_dx1.2_contained
 #   (the four rows before it ran with the gas acting on the copper only: case paper_coupling)
