@@ -14,7 +14,8 @@ rank reads one frame of one field of its own slice at a time).
   come from :mod:`postprocess.peaks`): the largest -sigma_rr and mean pressure of
   the rock's wall layer (r < R_b + wall_dx) and the largest gas pressure, and the
   mean pressure of the charge points of each z level at a few frames (pressure
-  along the borehole).
+  along the borehole).  With the ``gas_force`` field both take only the gas points
+  that act at the frame: a passive point keeps the pressure it stopped acting at.
 * Failure modes (Fig. 13): rock points per failure_mode at the last frame
   (0 intact, 1 JH2 plastic, 2 JH2 tensile, 3 tension model).
 * Gas containment, per frame, from the ``u`` field: the explosive's points whose
@@ -97,10 +98,11 @@ def scan(run, model, profile_frames) -> dict:
         if has_p:
             p = run.field("pressure", k)
             wall_p[k] = p[wall].max() if wall.any() else -np.inf
-            gas_p[k] = p[charge].max() if charge.any() else -np.inf
+            acting = charge & (run.field("gas_force", k) > 0.0) if has_force else charge
+            gas_p[k] = p[acting].max() if acting.any() else -np.inf
             if k in profile_frames and charge.any():
-                prof[k] = np.stack([run.per_level(np.where(charge, p, 0.0)),
-                                    run.per_level(charge.astype(float))], axis=1)
+                prof[k] = np.stack([run.per_level(np.where(acting, p, 0.0)),
+                                    run.per_level(acting.astype(float))], axis=1)
     out = {"time_s": run.time.tolist()}
     if not has_v:
         out["energy"] = {"not_available": "the run has no v field"}

@@ -474,6 +474,26 @@ def test_energy_paths_and_pressures(tmp_path):
     assert m["errors"] == []
 
 
+def test_gas_pressures_at_frames_take_only_the_acting_gas(tmp_path):
+    """With gas_force, a passive charge point (no force, its pressure frozen at 1 TPa)
+    is left out of the frame series and the profile; without the field it counts."""
+    x, part = lattice()
+    write_run(tmp_path / "run.h5")
+    charge = np.flatnonzero(part == 0)
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/pressure"][4, charge[0]] = 1e12
+    m, _ = analyse(tmp_path / "run.h5")
+    assert max(m["frame_series"]["gas_pressure_MPa"]) == pytest.approx(1e6)
+    force = np.ones((5, len(x)))
+    force[4, charge[0]] = 0.0
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f["fields/gas_force"] = force
+    m, _ = analyse(tmp_path / "run.h5")
+    assert max(m["frame_series"]["gas_pressure_MPa"]) < 1e5
+    prof = m["gas_profiles"][-1]
+    np.testing.assert_allclose(prof["p_MPa"], 100 * 5 * (1 + np.array(prof["z_mm"])))
+
+
 def test_rock_energy_without_elastic_energy_is_kinetic_only(tmp_path):
     """A file with only strain_energy (stress work, elastic + plastic): kinetic energy
     only, with the note — the stress work is never counted as energy in the rock."""
