@@ -243,6 +243,13 @@ def check_report(scene, ranks: int) -> str:
                 f"q = rho dx ({cq:g} dx (tr L)^2 - {cl:g} c tr L) in compression, at most "
                 f"rho dx^2 |tr L| / (2 dt); its work is the ledger's gas_viscous"
                 if cq > 0 or cl > 0 else "none"))
+            frac, kc = mat.contact_law
+            wdt = math.sqrt(6.0 * kc / mat.density) / p.dx * scene.time.dt
+            out.append("    contact with the solids: " + (
+                f"pairs closer than min({frac:g} l, |xi|) repel with {kc / 1e9:.3g} GPa x l "
+                f"x overlap (the ledger's gas_contact); omega dt = {wdt:.3g} for a gas point "
+                f"pressed on 6 solids (velocity Verlet is stable below 2)"
+                if frac > 0 else "none (gas may pass into the solids it acts on)"))
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")

@@ -60,6 +60,11 @@ implicit update has the closed form
 e^{n+1} = (e^n V0 - W_a/2 - (lam k f + (1 - lam) p_u) b/2) / (V0 + lam k w b / (2 V_R)).
 The volume itself, V <- V exp(tr L dt), is the EOS's argument.
 
+Contact (mpipd.materials.jwl.GasContact; off when ``frac`` is 0).  A gas-solid pair
+closer than d_c = min(frac l, |xi|), l the mean of the two points' lattice spacings
+V^(1/3), repels with F = k l (d_c - |Y|) on each point, k = stiffness x rho0 vod^2:
+equal and opposite, a potential force (:func:`gas_contact_energy`).
+
 Per point, the halo carries gd = [A (6, Voigt), V, p].
 """
 import math
@@ -95,6 +100,17 @@ def add_moment(M, wgt, y0, y1, y2):
     M[1, 1] += wgt * y1 * y1
     M[1, 2] += wgt * y1 * y2
     M[2, 2] += wgt * y2 * y2
+
+
+@numba.njit(cache=True, inline="always")
+def contact_reach(x, vol, i, j, frac):
+    """(d_c, l) of the gas-solid pair (i, j): l = (V_i^(1/3) + V_j^(1/3)) / 2 from the
+    reference volumes, d_c = min(frac l, |x_j - x_i|) (module docstring)."""
+    e0 = x[j, 0] - x[i, 0]
+    e1 = x[j, 1] - x[i, 1]
+    e2 = x[j, 2] - x[i, 2]
+    ell = 0.5 * (vol[i] ** (1.0 / 3.0) + vol[j] ** (1.0 / 3.0))
+    return min(frac * ell, math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)), ell
 
 
 @numba.njit(cache=True)
@@ -234,16 +250,26 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
 
 
 @numba.njit(cache=True)
-def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f):
+def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f,
+               x, frac=0.0, kc=0.0):
     """Add the updated-Lagrangian pair forces to f of the owned points ``rows``
-    (pair weights V_w for gas points, V_ref for solids; V0_ratio = V_w / V0)."""
+    (pair weights V_w for gas points, V_ref for solids; V0_ratio = V_w / V0), and the
+    gas-solid contact (``frac`` > 0; x: reference positions, kc = stiffness x K)."""
     for k in range(rows.shape[0]):
         i = rows[k]
         di = delta[i] if is_gas[i] else 0.0
         fx = fy = fz = 0.0
+        cx = cy = cz = 0.0                      # contact force (N)
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
             y0, y1, y2, ly = current_bond(y, i, j)
+            if frac > 0.0 and is_gas[i] != is_gas[j] and ly > 0.0:
+                dc, ell = contact_reach(x, V_ref, i, j, frac)
+                if ly < dc:
+                    g = kc * ell * (dc - ly) / ly       # |F| / |Y|, away from j
+                    cx -= g * y0
+                    cy -= g * y1
+                    cz -= g * y2
             tx = ty = tz = 0.0
             if ly < di:
                 w = (di - ly) * (di - ly)
@@ -262,6 +288,26 @@ def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f
             fy += ty * vj
             fz += tz * vj
         s = V0_ratio[i]
-        f[i, 0] += s * fx
-        f[i, 1] += s * fy
-        f[i, 2] += s * fz
+        f[i, 0] += s * fx + cx / V_ref[i]
+        f[i, 1] += s * fy + cy / V_ref[i]
+        f[i, 2] += s * fz + cz / V_ref[i]
+
+
+@numba.njit(cache=True)
+def gas_contact_energy(gas_idx, y, x, V_ref, offsets, nbr, is_gas, frac, kc):
+    """The contact's potential (J) over the gas-solid pairs of the owned gas points
+    ``gas_idx`` (each pair once, from its gas point): sum kc l (d_c - |Y|)^2 / 2."""
+    out = 0.0
+    if frac <= 0.0:
+        return out
+    for k in range(gas_idx.shape[0]):
+        i = gas_idx[k]
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            if is_gas[j]:
+                continue
+            ly = current_bond(y, i, j)[3]
+            dc, ell = contact_reach(x, V_ref, i, j, frac)
+            if ly < dc:
+                out += 0.5 * kc * ell * (dc - ly) ** 2
+    return out

@@ -27,6 +27,8 @@ material.
   exactly the trapezoidal work of the gas's pressure forces; it is the ledger's
   ``gas``.  With a bulk viscosity (the material's ``viscosity``), the work of its
   q is summed in ``viscous_work`` (this rank's share): the ledger's ``gas_viscous``.
+  With a contact (the material's ``contact``), gas-solid pairs repel when close:
+  its potential is the ledger's ``gas_contact``.
 """
 from __future__ import annotations
 
@@ -37,7 +39,7 @@ from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, in_box, max_moved2, merge_rows
-from ..kernels.ul import gas_gather, gas_update
+from ..kernels.ul import gas_contact_energy, gas_gather, gas_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
 from .base import Model
@@ -45,6 +47,8 @@ from .families import _csr_by_row
 
 #: Verlet skin of the gas families, as a fraction of the gas horizon
 SKIN = 0.2
+#: reference coordinate given to remote rows (:meth:`Gas._extend`)
+FAR = 1e30
 
 
 def lighting_times(scene, part: np.ndarray, z: np.ndarray, mat) -> np.ndarray:
@@ -110,6 +114,7 @@ class Gas(Model):
         self.n_singular = 0
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
         self.c_q, self.c_l = m.bulk_viscosity
+        self.contact_frac, self.contact_k = m.contact_law
         self.viscous = self.c_q > 0.0 or self.c_l > 0.0
         self.gq = np.zeros(len(self.gas_idx))    # bulk viscosity q of the last step
         self.viscous_work = 0.0                  # dissipated work of q, this rank (J): the
@@ -133,8 +138,12 @@ class Gas(Model):
         if n_remote:
             self.vol_ext = np.concatenate((p.volume, near.remote_volume))
             self.gid_ext = np.concatenate((p.gid, near.remote_gid))
+            # a remote row's reference position is only needed for the contact's cap
+            # d_c = min(frac l, |xi|): it is beyond this rank's static halo, so |xi| to
+            # any owned gas point exceeds a horizon (> frac l) and a far point serves
+            self.x_ext = np.concatenate((p.x, np.full((n_remote, 3), FAR)))
         else:
-            self.vol_ext, self.gid_ext = p.volume, p.gid
+            self.vol_ext, self.gid_ext, self.x_ext = p.volume, p.gid, p.x
         self.isgas_ext = np.concatenate((self.is_gas, np.zeros(n_remote, np.uint8)))
         self.h_ext = np.concatenate((self.gas_horizon, np.zeros(n_remote)))
         self.el_ext = np.concatenate((self.eligible,
@@ -283,7 +292,8 @@ class Gas(Model):
             self.search(p.x + u, v)
             self.y = self.y_ext
         gas_gather(self.rows, self.y, self.vol_ext, self.V_w, self.V_ratio, self.gd,
-                   p.horizon, self.offsets, self.nbr, self.isgas_ext, f)
+                   p.horizon, self.offsets, self.nbr, self.isgas_ext, f, self.x_ext,
+                   self.contact_frac, self.contact_k)
 
     def lit_density(self, team) -> dict:
         """Per charge (part name): the largest and the mean density at lighting over
@@ -308,6 +318,15 @@ class Gas(Model):
     def energy(self) -> float:
         """Internal energy of the owned gas (J): e per initial volume times V0."""
         return float(np.dot(self.e, self.V0))
+
+    def contact_energy(self) -> float:
+        """Potential of the gas-solid contact (J) over the owned gas points' pairs at
+        the positions of the last force gather (mpipd.kernels.ul.gas_contact_energy);
+        0 without a contact law."""
+        if self.contact_frac == 0.0 or self.y is None:
+            return 0.0
+        return gas_contact_energy(self.gas_idx, self.y, self.x_ext, self.vol_ext, self.offsets,
+                                  self.nbr, self.isgas_ext, self.contact_frac, self.contact_k)
 
     def carries_force(self) -> np.ndarray:
         """1 at the owned gas points whose force state is not zero after the last update

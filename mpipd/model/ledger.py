@@ -14,6 +14,8 @@ Terms (J, global sums over the owned points of every rank)::
                 spring       the bond-spring fallback's bonds
                 contact      the contact penalty of broken bonds in compression (Eq. 40)
                 gas          sum V0 e: the explosive's internal energy (unreacted included)
+                gas_contact  the gas-solid contact's potential (mpipd.materials.jwl.GasContact;
+                             0 without one)
     dissipated  plastic      sum over intact points V (W - e_el): plastic flow, damage
                              and the bulking pressure's work (W = the stress work)
                 removed      sum over failed or detached (K singular) points V W, plus
@@ -47,8 +49,8 @@ Terms (J, global sums over the owned points of every rank)::
                 scale = max(|initial|, |external|, |held|, |dissipated|)
 
 Every force the step applies is in exactly one of these: the correspondence
-force (its work is the stress work W, to O(dt^2)), hourglass, spring and
-contact (potentials), gas (its work leaves e by the trapezoidal energy
+force (its work is the stress work W, to O(dt^2)), hourglass, spring,
+contact and gas contact (potentials), gas (its work leaves e by the trapezoidal energy
 equation), viscosity, gas viscosity, damping, interface (their work), loads
 (external).
 So |balance| is the time-discretisation error, of order (omega dt)^2, plus
@@ -56,7 +58,7 @@ one-step errors where forces switch (a failure, a break): a term left out
 shows as a balance of its own size.
 
 Impossible values are errors: a held term that must be >= 0 below -tol
-(kinetic, elastic, hourglass, spring, contact, gas) or a dissipation below
+(kinetic, elastic, hourglass, spring, contact, gas, gas_contact) or a dissipation below
 -tol (plastic, removed, viscous, damping, gas_damping, gas_viscous, absorbed), tol = BALANCE_TOL x
 scale, are listed by :func:`impossible`.
 """
@@ -70,13 +72,15 @@ from ..kernels import energy as kern
 from ..kernels.layout import INTACT, SPRING_K
 from ..state import AUX, LAST
 
-HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas")
+HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas",
+        "gas_contact")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
               "gas_viscous", "absorbed", "interface", "multirate")
 #: the datasets of /energy in a run file, in this order
 TERMS = ("t",) + HELD + DISSIPATED + ("external", "initial", "balance")
 #: terms that cannot be negative (beyond round-off and O(dt^2) noise)
-NON_NEGATIVE = ("kinetic", "elastic", "hourglass", "spring", "contact", "gas", "plastic",
+NON_NEGATIVE = ("kinetic", "elastic", "hourglass", "spring", "contact", "gas", "gas_contact",
+                "plastic",
                 "removed", "viscous", "damping", "gas_damping", "gas_viscous", "absorbed")
 #: |balance| and the negative excursions that :func:`impossible` tolerates
 BALANCE_TOL = 1e-3
@@ -92,6 +96,7 @@ class Energies:
     spring: float = 0.0
     contact: float = 0.0
     gas: float = 0.0
+    gas_contact: float = 0.0
     plastic: float = 0.0
     removed: float = 0.0
     contact_onset: float = 0.0
@@ -132,7 +137,8 @@ class Energies:
     @classmethod
     def from_record(cls, group, frame: int = -1) -> "Energies":
         """The reading of one frame of a run file's ``/energy`` group (h5py); a term
-        the file predates (``multirate``, ``absorbed``, ``gas_viscous``) reads 0."""
+        the file predates (``multirate``, ``absorbed``, ``gas_viscous``, ``gas_contact``)
+        reads 0."""
         return cls(**{f.name: float(group[f.name][frame]) if f.name in group else 0.0
                       for f in fields(cls)})
 
@@ -238,6 +244,7 @@ class Ledger:
         pot = c.potentials(self.rows, sim.u).sum(axis=0)
         gas = sim.gas.energy() if sim.gas is not None else 0.0
         gas_viscous = sim.gas.viscous_work if sim.gas is not None else 0.0
+        gas_contact = sim.gas.contact_energy() if sim.gas is not None else 0.0
         damping = gas_damping = absorbed = 0.0
         if len(self.edamp):
             ed = m * self.edamp
@@ -245,7 +252,8 @@ class Ledger:
                 gas_damping = float(ed[sim.gas.gas_idx].sum())
             absorbed = float(ed[self.layer].sum())
             damping = float(ed.sum()) - gas_damping - absorbed
-        return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, plastic, removed,
+        return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, gas_contact,
+                         plastic, removed,
                          self.contact_jumps, -self.viscous_work, damping, gas_damping,
                          gas_viscous, absorbed,
                          -self.interface_work, self.reclass, sim.external_work])
