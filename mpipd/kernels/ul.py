@@ -288,9 +288,13 @@ def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f
             fy += ty * vj
             fz += tz * vj
         s = V0_ratio[i]
-        f[i, 0] += s * fx + cx / V_ref[i]
-        f[i, 1] += s * fy + cy / V_ref[i]
-        f[i, 2] += s * fz + cz / V_ref[i]
+        f[i, 0] += s * fx
+        f[i, 1] += s * fy
+        f[i, 2] += s * fz
+        if frac > 0.0:
+            f[i, 0] += cx / V_ref[i]
+            f[i, 1] += cy / V_ref[i]
+            f[i, 2] += cz / V_ref[i]
 
 
 @numba.njit(cache=True)
