@@ -18,10 +18,15 @@ pairs, a checkpoint written by N ranks restarts on M ranks, and the continued
 run is bit-identical to the uninterrupted one (tests/test_restart.py).
 
 Files are written collectively (h5py ``mpio``) to ``<name>.tmp`` and renamed
-by rank 0 once complete, so a checkpoint on disk is never half written.
+by rank 0 once complete, so a checkpoint on disk is never half written.  Before
+any of it is written, rank 0 compares the checkpoint's data size with the space
+free where it goes and every rank refuses together when it does not fit: a write
+that fails on one rank in the middle of a collective call leaves the others
+waiting in the next one.
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 from dataclasses import dataclass
@@ -52,6 +57,7 @@ def write(sim, path, scene_text: str, overrides=(), run_id: str = "") -> Path:
     an older checkpoint at ``path`` is untouched."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
+    _check_room(sim, path.parent, scene_text)
     try:
         _write(sim, tmp, scene_text, overrides, run_id)
     except BaseException:
@@ -66,6 +72,29 @@ def write(sim, path, scene_text: str, overrides=(), run_id: str = "") -> Path:
         os.replace(tmp, path)
     team.barrier()
     return path
+
+
+#: what a checkpoint holds besides its data (HDF5 headers, attributes), bytes
+OVERHEAD = 64 * 1024
+
+
+def _check_room(sim, where: Path, scene_text: str):
+    """Raise ENOSPC on every rank (collective) when the checkpoint's data (the
+    per-point datasets, the broken pairs and the scene text, plus OVERHEAD) exceed
+    the space free at ``where``, as rank 0 sees it."""
+    team = sim.team
+    n = sim.n_global
+    need = sum(n * a[:1].nbytes for a in _per_point(sim).values() if len(a)) if n else 0
+    need = team.max(need) + 16 * team.sum(int(np.count_nonzero(sim.families.broken))) \
+        + len(scene_text.encode()) + OVERHEAD
+    free = None
+    if team.root:
+        st = os.statvfs(where)
+        free = st.f_bavail * st.f_frsize
+    free = team.bcast(free)
+    if need > free:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC),
+                      f"{where}: a checkpoint needs about {need / 1e6:.3g} MB")
 
 
 def _write(sim, tmp, scene_text, overrides, run_id):
