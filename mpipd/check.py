@@ -36,7 +36,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .input.geometry import LayerTable
+from .input.geometry import LayerTable, part_points
 from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
@@ -128,24 +128,32 @@ def critical_dt(scene) -> float:
 
 def layer_bonds(scene, table) -> np.ndarray:
     """Total-Lagrangian bonds of every layer's points, counted from the cross-sections
-    (see the module docstring); 0 for gas layers."""
+    (see the module docstring); 0 for gas layers.  A prism's section is one for all
+    its levels; a part that is no prism (a rod) has one per level."""
     parts = scene.parts
     gas = [is_gas_part(scene, q) for q in parts]
     trees, sizes = {}, {}
-    for k, q in enumerate(parts):
-        if not gas[k]:
-            sx, sy = q.shape.cross_section(q.dx)
-            trees[k] = cKDTree(np.column_stack((sx, sy)))
-            sizes[k] = len(sx)
-    horizon = np.array([q.horizon for q in parts])
-    reach = max((horizon[k] for k in trees), default=0.0)
     z, part = table.z, table.part
+
+    def section(L):
+        k = int(part[L])
+        key = k if parts[k].shape.prism else (k, int(L))
+        if key not in trees:
+            sx, sy = (parts[k].shape.cross_section(parts[k].dx) if parts[k].shape.prism
+                      else parts[k].shape.section(parts[k].dx, z[L]))
+            trees[key] = cKDTree(np.column_stack((sx, sy)))
+            sizes[key] = len(sx)
+        return key
+
+    horizon = np.array([q.horizon for q in parts])
+    reach = max((horizon[k] for k in range(len(parts)) if not gas[k]), default=0.0)
     pairs = {}
 
-    def count(k, q, r):
-        key = (min(k, q), max(k, q), round(r / 1e-12))
+    def count(a, b, r):
+        a, b = sorted((a, b), key=repr)
+        key = (a, b, round(r / 1e-12))
         if key not in pairs:
-            pairs[key] = int(trees[key[0]].count_neighbors(trees[key[1]], r))
+            pairs[key] = int(trees[a].count_neighbors(trees[b], r))
         return pairs[key]
 
     out = np.zeros(len(z), np.int64)
@@ -165,9 +173,10 @@ def layer_bonds(scene, table) -> np.ndarray:
             if dz >= R:
                 continue
             r = math.sqrt(R * R - dz * dz) * (1.0 - 1e-12)     # |xi| < R, strictly
-            n += count(k, q, r)
+            a = section(L)
+            n += count(a, section(M), r)
             if M == L:
-                n -= sizes[k]                                   # a point is not its own bond
+                n -= sizes[a]                                   # a point is not its own bond
         out[L] = n
     return out
 
@@ -224,13 +233,19 @@ def check_report(scene, ranks: int) -> str:
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
         if is_gas_part(scene, p):
             ini = p.initiation
-            z0, d0, t0 = ((ini.z, ini.direction, ini.time) if ini is not None
-                          else (mat.initiation_z, mat.direction, 0.0))
-            zs = p.shape.z_range
-            t_last = t0 + max((zs[1] - z0) * d0, (zs[0] - z0) * d0) / mat.vod
-            out.append(f"    initiation: from z = {z0:g} m at t = {t0 * 1e6:.4g} us "
-                       f"({'+' if d0 > 0 else '-'}z), the charge lit by {t_last * 1e6:.4g} us"
-                       + ("" if ini is not None else " (the material's)"))
+            if ini is not None and ini.point is not None:
+                t_last = float(ini.times(part_points(p), mat.vod).max())
+                out.append(f"    initiation: from the point ({', '.join(f'{v:g}' for v in ini.point)})"
+                           f" m at t = {ini.time * 1e6:.4g} us, the charge lit by "
+                           f"{t_last * 1e6:.4g} us")
+            else:
+                z0, d0, t0 = ((ini.z, ini.direction, ini.time) if ini is not None
+                              else (mat.initiation_z, mat.direction, 0.0))
+                zs = p.shape.z_range
+                t_last = t0 + max((zs[1] - z0) * d0, (zs[0] - z0) * d0) / mat.vod
+                out.append(f"    initiation: from z = {z0:g} m at t = {t0 * 1e6:.4g} us "
+                           f"({'+' if d0 > 0 else '-'}z), the charge lit by "
+                           f"{t_last * 1e6:.4g} us" + ("" if ini is not None else " (the material's)"))
             u = mat.unreacted
             out.append("    before it is lit: " + (
                 f"inert, compacting freely to {mat.density * mat.unreacted_eos[2]:g} kg/m^3, then "

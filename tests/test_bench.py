@@ -16,7 +16,8 @@ def test_each_charge_is_lit_on_its_own_schedule():
     assert len(charges) == 3
     z = np.array([0.0, 0.003, 0.006] * 3)
     part = np.repeat(charges, 3)
-    t = lighting_times(scene, part, z, scene.materials["explosive"])
+    t = lighting_times(scene, part, np.column_stack((0 * z, 0 * z, z)),
+                       scene.materials["explosive"])
     for j, delay in enumerate((0.0, 8e-6, 16e-6)):    # the case's delays, + z / vod
         np.testing.assert_allclose(t[3 * j:3 * j + 3], delay + np.array([0, 0.003, 0.006]) / VOD,
                                    rtol=0, atol=1e-18)
@@ -25,7 +26,7 @@ def test_each_charge_is_lit_on_its_own_schedule():
 def test_a_charge_without_its_own_initiation_follows_the_material():
     scene, _ = sc.load("blast_demo", ["materials.explosive.initiation_z=0.006",
                                       "materials.explosive.direction=-1.0"])
-    t = lighting_times(scene, np.zeros(2, int), np.array([0.006, 0.0]),
+    t = lighting_times(scene, np.zeros(2, int), np.array([[0, 0, 0.006], [0, 0, 0.0]]),
                        scene.materials["explosive"])
     np.testing.assert_allclose(t, [0.0, 0.006 / VOD])
 

@@ -226,8 +226,14 @@ class BoreholePressure:
 
     def check_parts(self, parts, path):
         """The radius must be a wall: some part has a first layer there
-        (radius <= r < radius + dx) and no points inside it (r < radius)."""
+        (radius <= r < radius + dx) and no points inside it (r < radius); every part
+        is a prism along z (the load is a z borehole's, the same at every level)."""
         walls = 0
+        for k, part in enumerate(parts):
+            if not part.shape.prism:
+                fail(path, f"a borehole pressure needs parts that are prisms along z; part "
+                     f"{part.name!r} is not (parts[{k}].shape): a charge along another axis "
+                     "is an explosive part (the gas)")
         for part in parts:
             sx, sy = part.shape.cross_section(part.dx)
             rr = np.hypot(sx - self.center[0], sy - self.center[1])

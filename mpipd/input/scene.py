@@ -159,19 +159,32 @@ class Band:
 
 @dataclass(frozen=True)
 class Initiation:
-    """When and where a charge (a part of the explosive) is lit: the face z = ``z`` at
-    ``time`` (s), the detonation running along +z (``direction`` 1) or -z (-1): a
-    point at reference height z' is lit at time + (z' - z) direction / vod
-    (mpipd.model.gas).  A charge without one follows its material's initiation_z
-    and direction at time 0."""
+    """When and where a charge (a part of the explosive) is lit, at ``time`` (s):
+    from the face z = ``z``, the detonation running along +z (``direction`` 1) or
+    -z (-1), so that a point at reference height z' is lit at
+    time + (z' - z) direction / vod; or from a ``point`` (x, y, z), a primer, the
+    front running out from it in every direction, so that a point at reference
+    position x' is lit at time + |x' - point| / vod (a charge along any axis,
+    :class:`mpipd.input.geometry.Rod`).  mpipd.model.gas.lighting_times.  A
+    charge without one follows its material's initiation_z and direction at
+    time 0."""
     z: float = 0.0
     time: float = 0.0
     direction: float = 1.0
+    point: tuple[float, float, float] | None = None
 
     def check(self, path):
         non_negative(self, path, "time")
         if self.direction not in (1.0, -1.0):
             fail(join(path, "direction"), "must be 1 or -1")
+        if self.point is not None and (self.z != 0.0 or self.direction != 1.0):
+            fail(join(path, "point"), "give either point or z and direction, not both")
+
+    def times(self, x, vod):
+        """Lighting times of reference positions ``x`` (n, 3) (class docstring)."""
+        if self.point is not None:
+            return self.time + np.linalg.norm(x - np.asarray(self.point), axis=1) / vod
+        return self.time + (x[:, 2] - self.z) * self.direction / vod
 
 
 @dataclass(frozen=True)

@@ -51,17 +51,18 @@ SKIN = 0.2
 FAR = 1e30
 
 
-def lighting_times(scene, part: np.ndarray, z: np.ndarray, mat) -> np.ndarray:
-    """The time each gas point is lit (programmed burn, paper §2.6): for a charge with
-    its own ``initiation`` (mpipd.input.scene.Initiation) t_L = time + (z - z_i) dir / vod,
-    otherwise the material's t_L = (z - initiation_z) direction / vod.  Several
-    charges of one explosive each follow their own schedule (delays)."""
-    t = (z - mat.initiation_z) * mat.direction / mat.vod
+def lighting_times(scene, part: np.ndarray, x: np.ndarray, mat) -> np.ndarray:
+    """The time each gas point (reference position ``x``, (n, 3)) is lit (programmed
+    burn, paper §2.6): for a charge with its own ``initiation``, from its face or
+    point (mpipd.input.scene.Initiation.times), otherwise the material's
+    t_L = (z - initiation_z) direction / vod.  Several charges of one explosive
+    each follow their own schedule (delays)."""
+    t = (x[:, 2] - mat.initiation_z) * mat.direction / mat.vod
     for k, q in enumerate(scene.parts):
         ini = q.initiation
         if ini is not None:
             sel = part == k
-            t[sel] = ini.time + (z[sel] - ini.z) * ini.direction / mat.vod
+            t[sel] = ini.times(x[sel], mat.vod)
     return t
 
 
@@ -95,7 +96,7 @@ class Gas(Model):
         self.V0 = p.volume[self.gas_idx].copy()
         self.e = np.full(len(self.gas_idx), self.mat.e0)
         m = self.mat
-        self.t_lit = lighting_times(scene, p.part[self.gas_idx], p.x[self.gas_idx, 2], m)
+        self.t_lit = lighting_times(scene, p.part[self.gas_idx], p.x[self.gas_idx], m)
         self.vr_lit = np.zeros(len(self.gas_idx))     # V_R when first lit (0: not yet)
         self.part_names = [q.name for q in scene.parts]
         dx = float(p.dx[self.gas_idx].max()) if len(self.gas_idx) else 0.0
