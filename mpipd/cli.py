@@ -253,7 +253,8 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         full, planar, left = (team.sum(c) for c in sim.interface.counts)
         log(f"mpipd: interface correction: {full} point(s) in full, {planar} in the x-y "
             f"plane (near a z face); {left} keep their ghost force (an interface within "
-            "two horizons of an x-y free surface, README)")
+            "two horizons of an x-y free surface, or of a part that is no prism along z, "
+            "README)")
     if sim.joint_bonds:
         log(f"mpipd: joints: {sim.joint_bonds} bond(s) start broken (counted from both ends)")
     writer = Writer(h5, sim, shown, n_steps, resume=resume, run_id=run_id)

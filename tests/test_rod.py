@@ -242,3 +242,24 @@ def test_part_points_lists_every_site():
     pts = part_points(rock)
     x, y = rock.shape.cross_section(rock.dx)
     assert len(pts) == len(x) * len(rock.shape.z_levels(rock.dx))
+
+
+def test_near_a_rod_or_an_axis_hole_the_body_is_no_prism():
+    """The interface correction's prism test (geometry.prisms_inside) is False within
+    the reach of a rod or of a box's hole along another axis, and unchanged away from
+    them; the reach may differ from point to point (an array)."""
+    from types import SimpleNamespace as NS
+
+    from mpipd.input.geometry import prisms_inside
+    box = Box(lo=(0.0, 0.0, 0.0), hi=(0.02, 0.02, 0.02))
+    rod = Rod(start=(0.0, 0.005, 0.005), end=(0.02, 0.005, 0.005), radius=0.001,
+              inner_radius=0.0005)
+    holed = Box(lo=box.lo, hi=box.hi, holes=(Hole(start=rod.start, end=rod.end, radius=0.001),))
+    # far; 2.5 mm from the rod's surface (the last two: within the reach, then not)
+    x = np.array([[0.01, 0.015, 0.015], [0.01, 0.005, 0.0075], [0.01, 0.005, 0.0085],
+                  [0.01, 0.005, 0.0085]])
+    reach = np.array([0.002, 0.002, 0.003, 0.002])
+    base = prisms_inside([NS(shape=box, dx=1e-3)], x, reach)
+    assert base.tolist() == [True, True, True, True]
+    for parts in ([NS(shape=box, dx=1e-3), NS(shape=rod, dx=1e-3)], [NS(shape=holed, dx=1e-3)]):
+        assert prisms_inside(parts, x, reach).tolist() == [True, False, False, True]

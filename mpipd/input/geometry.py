@@ -300,9 +300,9 @@ class Rod:
         s, d2 = self._split(ox, oy, oz)
         r = self.radius - margin
         ok = (s > margin) & (s < self.length - margin) & (d2 < r * r) & (r > 0.0)
-        ri = self.inner_radius + margin
-        if self.inner_radius > 0.0 and ri > 0.0:
-            ok &= d2 > ri * ri
+        if self.inner_radius > 0.0:                 # margin may be an array (a reach per point)
+            ri = self.inner_radius + margin
+            ok &= (ri <= 0.0) | (d2 > ri * ri)
         return ok
 
     def contains(self, x, y, z, margin):
