@@ -109,24 +109,25 @@ def test_a_charge_lit_from_a_point_burns_outward_at_the_vod():
     assert t[3] == 0.0                                  # charge1 keeps its face at z = 0
 
 
-def test_bad_rods_holes_and_initiations(tmp_path):
+BAD = [
+    ('parts.0.shape={ kind = "rod", start = [0, 0, 0], end = [0, 0, 0], radius = 1e-3 }',
+     "parts[0].shape.end", "must differ from start"),
+    ('parts.0.shape={ kind = "rod", start = [0, 0, 0], end = [0.01, 0, 0], radius = 1e-3, '
+     'inner_radius = 1e-3 }', "parts[0].shape.inner_radius", "[0, radius)"),
+    ("parts.6.shape.holes.0={ center = [0.0, 0.015], start = [0, 0, 0], radius = 1e-3 }",
+     "parts[6].shape.holes[0]", "either center"),
+    ("parts.6.shape.holes.0={ start = [0, 0, 0], radius = 1e-3 }",
+     "parts[6].shape.holes[0]", "both start and end"),
+    ("parts.0.initiation={ point = [0, 0, 0], z = 0.003 }",
+     "parts[0].initiation.point", "not both"),
+]
+
+
+@pytest.mark.parametrize("setting,key,reason", BAD)
+def test_bad_rods_holes_and_initiations(tmp_path, setting, key, reason):
     out = tmp_path / "out"
-    rod = 'parts.0.shape={ kind = "rod", start = [0, 0, 0], end = [0, 0, 0], radius = 1e-3 }'
-    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", rod]), out,
-              "parts[0].shape.end", "must differ from start")
-    rod = ('parts.0.shape={ kind = "rod", start = [0, 0, 0], end = [0.01, 0, 0], radius = 1e-3, '
-           'inner_radius = 1e-3 }')
-    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", rod]), out,
-              "parts[0].shape.inner_radius", "[0, radius)")
-    hole = "parts.6.shape.holes.0={ center = [0.0, 0.015], start = [0, 0, 0], radius = 1e-3 }"
-    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", hole]), out,
-              "parts[6].shape.holes[0]", "either center")
-    hole = "parts.6.shape.holes.0={ start = [0, 0, 0], radius = 1e-3 }"
-    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", hole]), out,
-              "parts[6].shape.holes[0]", "both start and end")
-    ini = "parts.0.initiation={ point = [0, 0, 0], z = 0.003 }"
-    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", ini]), out,
-              "parts[0].initiation.point", "not both")
+    check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set", setting]), out,
+              key, reason)
 
 
 def test_a_borehole_pressure_refuses_a_part_along_another_axis(tmp_path):
