@@ -66,9 +66,11 @@ def overbreak_depth(fraction: np.ndarray, counts: np.ndarray, dx: float,
 
 def _rock_box(scene):
     for k, q in enumerate(scene.parts):
-        if getattr(q.shape, "holes", ()):
+        holes = getattr(q.shape, "holes", ())
+        if holes and all(h.along_z for h in holes):
             return k, q
-    raise RunFileError("bench: the scene has no box part with holes (a bench blast)")
+    raise RunFileError("bench: the scene has no box part with holes along z (a bench blast: "
+                       "a row of vertical holes parallel to a free face)")
 
 
 def bench_metrics(path, comm) -> dict:

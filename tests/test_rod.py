@@ -1,9 +1,12 @@
 """Charges, tubes and holes along any axis (issue 19): the ``rod`` shape, a box's hole
 along an axis other than z, and a charge lit from a point."""
+import subprocess
+import sys
+
 import h5py
 import numpy as np
 import pytest
-from conftest import restart_matches, run_cli
+from conftest import child_env, restart_matches, run_cli
 from test_scene_errors import check_bad
 
 from mpipd.input import scene as sc
@@ -235,6 +238,11 @@ def test_a_charge_along_x_gives_the_z_charges_answer_mirrored(tmp_path):
                    "--stop-after", "60"], ranks=2, timeout=300)
     assert res.returncode == 0, res.stdout + res.stderr
     restart_matches(d / "checkpoint.h5", runs["x", 2], ("fields/u", "fields/damage"), ranks=3)
+    # the bench measures need vertical holes: one line, status 2, for a hole along x
+    res = subprocess.run([sys.executable, "-m", "postprocess", "bench", str(runs["x", 2])],
+                         capture_output=True, text=True, timeout=120, env=child_env())
+    assert res.returncode == 2 and "holes along z" in res.stderr, res.stderr
+    assert len([ln for ln in res.stderr.splitlines() if ln.strip()]) == 1
 
 
 def test_part_points_lists_every_site():
