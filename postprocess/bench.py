@@ -144,13 +144,12 @@ def bench_metrics(path, comm) -> dict:
 
 def make_bench(runs, labels, out, comm) -> list[str]:
     out = Path(out)
-    rows = {}
+    # every run's bench measures first: a run that is no bench stops it before any write
+    rows = {label: bench_metrics(path, comm) for path, label in zip(runs, labels)}
     for path, label in zip(runs, labels):
         make_fragments(path, out / label, comm, min_points=8)
-        m = bench_metrics(path, comm)
         if comm.Get_rank() == 0:
-            m["fragments"] = json.loads((out / label / "fragments.json").read_text())
-        rows[label] = m
+            rows[label]["fragments"] = json.loads((out / label / "fragments.json").read_text())
     if comm.Get_rank() != 0:
         return []
     (out / "bench.json").write_text(json.dumps(rows, indent=1, default=float) + "\n")
