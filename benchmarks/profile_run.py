@@ -91,6 +91,7 @@ def main(argv=None) -> int:
     team.barrier()
     walls = team.gather(wall)
     tables = team.gather(own_times(prof))
+    classes = sim.classes.summary(team) if sim.classes.enabled else "single-rate"
     if not team.root:
         return 0
     wall = max(walls)
@@ -113,7 +114,8 @@ def main(argv=None) -> int:
              f"per rank: {', '.join(f'{w:.1f}' for w in walls)} s)"
              + (f"; {bonds / 1e6:.1f} M bonds, {bonds * args.steps / wall / 1e6:.2f} M bond-steps/s "
                 f"({bonds * args.steps / wall / 1e6 / team.size:.2f} per rank)" if bonds else "")
-             + ".  Own time of each function (without its callees), summed over its calls:", "",
+             + ".", "", f"Step classes at the end: {classes}.", "",
+             "Own time of each function (without its callees), summed over its calls:", "",
              "| function | own time, mean over ranks (s) | largest rank (s) | share of the loop | calls (a rank) |",
              "|---|---|---|---|---|"]
     for mean, mx, calls, n in rows[:args.top]:
