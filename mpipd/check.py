@@ -37,6 +37,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .input.geometry import LayerTable, part_points
+from .model.gas import lighting_times
 from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
@@ -233,16 +234,15 @@ def check_report(scene, ranks: int) -> str:
                    f"(c_p = {mat.p_wave_speed:.1f} m/s)")
         if is_gas_part(scene, p):
             ini = p.initiation
+            pts = part_points(p)
+            t_last = float(lighting_times(scene, np.full(len(pts), k), pts, mat).max())
             if ini is not None and ini.point is not None:
-                t_last = float(ini.times(part_points(p), mat.vod).max())
                 out.append(f"    initiation: from the point ({', '.join(f'{v:g}' for v in ini.point)})"
                            f" m at t = {ini.time * 1e6:.4g} us, the charge lit by "
                            f"{t_last * 1e6:.4g} us")
             else:
                 z0, d0, t0 = ((ini.z, ini.direction, ini.time) if ini is not None
                               else (mat.initiation_z, mat.direction, 0.0))
-                zs = p.shape.z_range
-                t_last = t0 + max((zs[1] - z0) * d0, (zs[0] - z0) * d0) / mat.vod
                 out.append(f"    initiation: from z = {z0:g} m at t = {t0 * 1e6:.4g} us "
                            f"({'+' if d0 > 0 else '-'}z), the charge lit by "
                            f"{t_last * 1e6:.4g} us" + ("" if ini is not None else " (the material's)"))

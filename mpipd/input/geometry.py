@@ -296,8 +296,14 @@ class Rod:
         px, py, pz = ox - s * a[0], oy - s * a[1], oz - s * a[2]
         return s, px * px + py * py + pz * pz
 
-    def _inside(self, ox, oy, oz, margin):
-        s, d2 = self._split(ox, oy, oz)
+    def _closed(self, s, d2):
+        """The lattice rule (class docstring): the closed solid, from _split."""
+        return ((s >= 0.0) & (s <= self.length) & (d2 <= self.radius ** 2)
+                & (d2 >= self.inner_radius ** 2))
+
+    def contains(self, x, y, z, margin):
+        """Inside, ``margin`` from the surface (outward for a negative margin)."""
+        s, d2 = self._split(x - self.start[0], y - self.start[1], z - self.start[2])
         r = self.radius - margin
         ok = (s > margin) & (s < self.length - margin) & (d2 < r * r) & (r > 0.0)
         if self.inner_radius > 0.0:                 # margin may be an array (a reach per point)
@@ -305,15 +311,9 @@ class Rod:
             ok &= (ri <= 0.0) | (d2 > ri * ri)
         return ok
 
-    def contains(self, x, y, z, margin):
-        """Inside, ``margin`` from the surface (outward for a negative margin)."""
-        return self._inside(x - self.start[0], y - self.start[1], z - self.start[2], margin)
-
     def covers(self, x, y, z):
         """The lattice rule (class docstring), at any points: the closed solid."""
-        s, d2 = self._split(x - self.start[0], y - self.start[1], z - self.start[2])
-        return ((s >= 0.0) & (s <= self.length) & (d2 <= self.radius ** 2)
-                & (d2 >= self.inner_radius ** 2))
+        return self._closed(*self._split(x - self.start[0], y - self.start[1], z - self.start[2]))
 
     def _offsets(self, lo, hi, k, dx):
         """Site offsets (i + 1/2) dx from start along axis k within [lo, hi]."""
@@ -330,9 +330,7 @@ class Rod:
         ox, oy = self._offsets(lo, hi, 0, dx), self._offsets(lo, hi, 1, dx)
         X, Y = np.meshgrid(ox, oy, indexing="xy")      # rows = y: ravel is (y, x) order
         X, Y = X.ravel(), Y.ravel()
-        s, d2 = self._split(X, Y, self._level_offset(dx, z))
-        keep = ((s >= 0.0) & (s <= self.length) & (d2 <= self.radius ** 2)
-                & (d2 >= self.inner_radius ** 2))
+        keep = self._closed(*self._split(X, Y, self._level_offset(dx, z)))
         return X[keep] + self.start[0], Y[keep] + self.start[1]
 
     def z_levels(self, dx):
