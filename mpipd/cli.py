@@ -280,7 +280,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
                        checkpointer=checkpointer)
     except Unstable as e:
         writer.close()
-        log(f"mpipd: error: {e}; state saved in {checkpointer.written}", error=True)
+        over = sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+        log(f"mpipd: error: {e}; state saved in {checkpointer.written}"
+            + (f"; {over}" if over else ""), error=True)
         return EXIT_UNSTABLE
     writer.close(segment())
     if sim.step_count == n_steps:
@@ -300,8 +302,10 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))
             + f"; {broken} bonds broken")
     if sim.classes.enabled:
-        line = sim.classes.summary(team)
-        log("mpipd: " + line)
+        log("mpipd: " + sim.classes.summary(team))
+        over = sim.classes.over_line(team, list(scene.materials))
+        if over:
+            log(f"mpipd: warning: {over}", error=True)
     from .model.ledger import impossible
     e = sim.energies()
     log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "

@@ -208,3 +208,64 @@ def test_a_probe_in_a_coarse_class_is_timed_at_its_updates():
     t_state = first_arrival(*state_samples(mr, -mr["sigma_rr"]))["t_s"]
     assert abs(t_state - t_sr) < 0.5 * dt                 # measured 0.09 dt
     assert t_raw - t_sr > 1.0 * dt                        # measured 2.16 dt late
+
+
+def _rotation(rng):
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    return q * np.sign(np.diag(r))
+
+
+def test_min_stretch_is_the_smallest_principal_stretch():
+    """kernels.classes.min_stretch on left stretches V = Q diag(l) Q^T built from known
+    principal stretches l (random rotations Q, repeated and equal stretches too): it
+    gives min(1, min l) for an intact correspondence point, and 1 on the bond
+    springs, for a failed point or for the gas."""
+    from mpipd.kernels.classes import min_stretch
+    from mpipd.kernels.layout import MODE_TENSION, NOT_TL, SPRING_F
+    rng = np.random.default_rng(7)
+    lams = [(1.0, 1.0, 1.0), (3.15, 1.26, 0.25), (0.5, 0.5, 2.0), (0.9, 0.9, 0.9),
+            (1.3, 1.1, 1.2), (1e-3, 1.0, 1.0)] + [tuple(rng.uniform(0.1, 3.0, 3))
+                                                  for _ in range(200)]
+    V = np.array([(q := _rotation(rng)) @ np.diag(lam) @ q.T for lam in lams])
+    want = np.minimum(1.0, np.array([min(lam) for lam in lams]))
+    n = len(V)
+    out = np.empty(n)
+    min_stretch(V, np.arange(n), np.zeros(n, np.uint8), np.zeros(n, np.uint8), out)
+    assert np.max(np.abs(out - want)) < 1e-9
+    spring = np.zeros(n, np.uint8)
+    mode = np.zeros(n, np.uint8)
+    spring[1], spring[2], mode[3] = SPRING_F, NOT_TL, MODE_TENSION
+    min_stretch(V, np.arange(4), spring, mode, out[:4])
+    assert np.all(out[1:4] == 1.0) and out[0] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_a_thinned_point_takes_a_finer_class_and_one_beyond_dt_is_named():
+    """The class rule follows the deformed spacing: in a bar whose points all take
+    class 3 at rest, points whose left stretch V is thinned to lambda in one
+    direction take floor(log2(r lambda)) (r: their ratio at rest), and one thinned
+    below dt / dt_i is counted over dt and named by gid in the run log's line."""
+    dt = 1e-8
+    scene, _ = sc.load("elastic_wave", BAR + [f"time.dt={dt}", "time.t_end=1.6e-6",
+                                               "time.multirate={max_ratio=8, safety=1.0}"])
+    sim = Simulation(scene, _team())
+    cl, corr = sim.classes, sim.corr
+    n = sim.points.n_owned
+    r0 = cl.dtc[0] * cl.cp0[0] / C_P / dt * cl.safety         # ratio at rest
+    assert np.allclose(cl.dtc * cl.cp0, cl.dtc[0] * cl.cp0[0]) and r0 > 9
+    assert np.all(cl.klass[:n] == 3)
+    names = list(scene.materials)
+    assert cl.over_line(sim.team, names) is None
+    # thin three points, one in each direction of a rotated frame
+    rng = np.random.default_rng(3)
+    picks = {10: 9.0 / r0, 500: 3.0 / r0, 900: 0.5 / r0}        # ratios 9, 3, 0.5
+    for i, lam in picks.items():
+        q = _rotation(rng)
+        corr.V[i] = q @ np.diag([1.2, lam, 1.0]) @ q.T
+    k = cl.base_classes(corr, step=8)
+    for i, lam in picks.items():
+        ratio = cl.safety * cl.dtc[i] * lam * cl.cp0[i] / C_P / dt
+        assert k[i] == min(3, max(0, int(np.floor(np.log2(ratio))))), (i, lam, ratio)
+    assert k[10] == 3 and k[500] == 1 and k[900] == 0
+    assert cl.over_now == 1
+    line = cl.over_line(sim.team, names)
+    assert f"{names[sim.points.material[900]]} 0.500 dt at gid {int(sim.points.gid[900])}" in line

@@ -11,6 +11,9 @@ and x * 1.0 == x, so the kernels give the single-rate numbers bit for bit.
 """
 import numba
 
+from .layout import CORRESPONDENCE, INTACT
+from .linalg import sym3_min_eig
+
 
 @numba.njit(cache=True, inline="always")
 def weight(k, level):
@@ -28,3 +31,20 @@ def family_min(offsets, nbr, a, out):
             if a[nbr[b]] < m:
                 m = a[nbr[b]]
         out[i] = m
+
+
+@numba.njit(cache=True)
+def min_stretch(V, idx, spring, mode, out):
+    """out[k] = min(1, lambda_min(V_i)) for i = idx[k]: the smallest principal stretch
+    (eigenvalue of the left stretch V, F = V R) of an intact point on the
+    correspondence force, the factor by which the deformation has shortened its
+    shortest lattice spacing; 1 for a point on the bond springs or failed (no
+    stress of its material; its bonds' own lengths are not followed here)."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        lam = 1.0
+        if spring[i] == CORRESPONDENCE and mode[i] == INTACT:
+            lam = min(1.0, sym3_min_eig(V[i]))
+            if lam < 1e-6:
+                lam = 1e-6
+        out[k] = lam

@@ -32,16 +32,27 @@ Darve & Lew 2008, JCP 227, for the stability analysis):
 Class rule (at every coarse boundary, identical on any number of ranks: a
 function of each point's own state, then of its family by halo exchange):
 
-    r_i  = safety * dt_c,i * c_p,i / c_i(state) / dt     (dt_c,i: mpipd.check.stable_dt
+    dt_i = dt_c,i * lambda_i * c_p,i / c_i(state)        (the point's stable step now;
+                                                          dt_c,i: mpipd.check.stable_dt
                                                           of the point's part; c_p,i its
                                                           reference P-wave speed)
+    r_i  = safety * dt_i / dt
     base = floor(log2 r_i), clipped to 0..log2(max_ratio), 0 for the gas
     k_i  = min over i's family (bonds broken or not) of base_j    (the buffer)
 
 c_i(state) is the material's P-wave speed at the larger of its compression now
 and the compression extrapolated over two coarse steps at its current rate
 (``Material.p_wave_speed_at``: JH2's EOS stiffens steeply, a crushed-zone point
-must take the fine class before it gets there).  Coarsening needs
+must take the fine class before it gets there), and lambda_i = min(1, smallest
+principal stretch of V_i) (``kernels.classes.min_stretch``): dt_c,i is the transit
+of the reference spacing, and a point thinned to lambda of it in one direction
+has its wave cross the spacing in lambda times the time (Courant-Friedrichs-Lewy
+on the current configuration; a copper tube driven to 2.4 x its radius is
+thinned to lambda = 0.25, docs/validation_notes.md §13).  A point whose dt_i is
+below dt itself cannot be helped by any class (class 0 is dt): the boundary
+counts it (``over``), and the run log and the error of an unstable run name the
+worst such point; the scene's remedy is a smaller dt with a larger max_ratio
+(the same coarse step).  Coarsening needs
 ``HYSTERESIS`` x the margin (no class flicker at a threshold); refining is
 immediate.  The buffer makes every element's class no coarser than any point
 it pushes.  When a class changes, the forces at the boundary are gathered
@@ -53,7 +64,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import family_min
+from ..kernels.classes import family_min, min_stretch
 from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
@@ -114,6 +125,13 @@ class StepClasses:
         #: u (owned + ghosts) at the last update of each coarse class 1..top: a point
         #: whose family changes between its updates rebuilds F at those positions
         self.u_then = np.zeros((self.top, nl, 3))
+        #: the stable steps dt_i below dt (this rank, this invocation): coarse steps
+        #: with one, the first such step, the smallest dt_i / dt of each material
+        self.over_steps = 0
+        self.over_first = -1
+        self.over_worst = {}                            # material id -> (dt_i / dt, gid)
+        self.over_now = 0                               # points over dt at the last boundary
+        self.gid = points.gid[:n]
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -195,6 +213,7 @@ class StepClasses:
         if self._held is not None:
             return self._held
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
+        now = np.full(n, np.inf)                        # dt_i / dt at the state now
         horizon = 2.0 * self.ratio * self.dt
         for g in corr.groups:
             idx = g.idx
@@ -202,8 +221,13 @@ class StepClasses:
             d = corr.d[idx]
             rate = -(d[:, 0] + d[:, 1] + d[:, 2]) * (1.0 + mu)
             mu_ahead = mu + np.maximum(rate, 0.0) * horizon
-            c = np.maximum(g.material.p_wave_speed_at(mu), g.material.p_wave_speed_at(mu_ahead))
-            r[idx] = self.safety * self.dtc[idx] * self.cp0[idx] / c / self.dt
+            c_now = g.material.p_wave_speed_at(mu)
+            c = np.maximum(c_now, g.material.p_wave_speed_at(mu_ahead))
+            lam = np.empty(len(idx))
+            min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
+            now[idx] = self.dtc[idx] * lam * self.cp0[idx] / c_now / self.dt
+            r[idx] = self.safety * now[idx] * c_now / c
+        self._count_over(now, corr.points.material[:n], step)
         with np.errstate(divide="ignore"):
             down = np.floor(np.log2(np.maximum(r, 1e-300)))
             up = np.floor(np.log2(np.maximum(r / HYSTERESIS, 1e-300)))
@@ -214,6 +238,42 @@ class StepClasses:
         # steps takes the finest class
         k[step - self.touched <= RECENT * self.ratio] = 0
         return k
+
+    def _count_over(self, ratio, material, step: int):
+        """Book the owned points whose stable step now, dt_i = ratio * dt, is below dt
+        (the extrapolated compression of the class rule aside: what holds now)."""
+        over = np.flatnonzero(ratio < 1.0)
+        self.over_now = len(over)
+        if not len(over):
+            return
+        self.over_steps += 1
+        if self.over_first < 0:
+            self.over_first = step
+        for m in np.unique(material[over]):
+            sel = over[material[over] == m]
+            w = sel[np.argmin(ratio[sel])]
+            if ratio[w] < self.over_worst.get(int(m), (np.inf,))[0]:
+                self.over_worst[int(m)] = (float(ratio[w]), int(self.gid[w]))
+
+    def over_line(self, team, names) -> str | None:
+        """One line (collective) on the points whose stable step fell below dt in this
+        invocation, or None if none did: since when, how often, and the smallest
+        dt_i / dt of each material (``names``: by material id) with its point."""
+        got = team.gather((self.over_steps, self.over_first, self.over_worst))
+        hit = [g for g in got if g[0]]
+        if not hit:
+            return None
+        first = min(g[1] for g in hit)
+        worst = {}
+        for g in hit:
+            for m, w in g[2].items():
+                worst[m] = min(worst.get(m, w), w)
+        each = "; ".join(f"{names[m]} {w[0]:.3f} dt at gid {w[1]}" for m, w in sorted(worst.items()))
+        return (f"the step dt = {self.dt:.4g} s was above the stable step now of some points "
+                f"(their P-wave speed at their compression over their smallest principal "
+                f"stretch, mpipd.model.multirate) from step {first} on, at up to "
+                f"{max(g[0] for g in hit)} coarse steps; smallest: {each}. A smaller "
+                f"time.dt with a larger max_ratio keeps the coarse step")
 
     def classify(self, corr, halo, step: int) -> bool:
         """New classes from the current state (at a coarse boundary); True if any
