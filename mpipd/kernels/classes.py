@@ -12,7 +12,7 @@ and x * 1.0 == x, so the kernels give the single-rate numbers bit for bit.
 import numba
 
 from .layout import CORRESPONDENCE, INTACT
-from .linalg import sym3_min_eig
+from .linalg import principal_max_min
 
 
 @numba.njit(cache=True, inline="always")
@@ -44,7 +44,11 @@ def min_stretch(V, idx, spring, mode, out):
         i = idx[k]
         lam = 1.0
         if spring[i] == CORRESPONDENCE and mode[i] == INTACT:
-            lam = min(1.0, sym3_min_eig(V[i]))
+            _, lam = principal_max_min(V[i, 0, 0], V[i, 1, 1], V[i, 2, 2],
+                                       0.5 * (V[i, 1, 2] + V[i, 2, 1]),
+                                       0.5 * (V[i, 0, 2] + V[i, 2, 0]),
+                                       0.5 * (V[i, 0, 1] + V[i, 1, 0]))
+            lam = min(1.0, lam)
             if lam < 1e-6:
                 lam = 1e-6
         out[k] = lam

@@ -79,24 +79,26 @@ def mat_to_voigt(m, out):
 
 
 @numba.njit(cache=True, inline="always")
-def sym3_min_eig(a):
-    """Smallest eigenvalue of the symmetric part of ``a``, in closed form (Smith
-    1961, Commun. ACM 4(4) 168): with q = tr(a)/3, p^2 = |a - qI|_F^2 / 6 and
-    r = det((a - qI)/p)/2 in [-1, 1], the eigenvalues are
-    q + 2p cos(acos(r)/3 + 2 pi m/3), m = 0, 1, 2; the smallest is m = 1."""
-    a01 = 0.5 * (a[0, 1] + a[1, 0])
-    a02 = 0.5 * (a[0, 2] + a[2, 0])
-    a12 = 0.5 * (a[1, 2] + a[2, 1])
+def principal_max_min(a00, a11, a22, a12, a02, a01):
+    """Largest and smallest eigenvalue of a symmetric 3x3 matrix, in closed form
+    (Smith 1961, Commun. ACM 4(4) 168): with q = tr/3, p^2 = |a - qI|^2 / 6 and
+    r = det((a - qI)/p)/2, the eigenvalues are q + 2p cos(acos(r)/3 + 2 pi m/3)."""
     p1 = a01 * a01 + a02 * a02 + a12 * a12
-    q = (a[0, 0] + a[1, 1] + a[2, 2]) / 3.0
-    b00, b11, b22 = a[0, 0] - q, a[1, 1] - q, a[2, 2] - q
+    q = (a00 + a11 + a22) / 3.0
+    b00, b11, b22 = a00 - q, a11 - q, a22 - q
     p2 = b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * p1
-    if p2 <= 1e-30 * (q * q + 1e-300):            # a multiple of the identity
-        return min(a[0, 0], min(a[1, 1], a[2, 2]))
+    if p2 <= 1e-300:
+        return q, q
     p = math.sqrt(p2 / 6.0)
     det = (b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02)
            + a02 * (a01 * a12 - b11 * a02))
     r = det / (2.0 * p * p * p)
-    r = min(1.0, max(-1.0, r))
-    phi = math.acos(r) / 3.0
-    return q + 2.0 * p * math.cos(phi + 2.0 * math.pi / 3.0)
+    if r <= -1.0:
+        phi = math.pi / 3.0
+    elif r >= 1.0:
+        phi = 0.0
+    else:
+        phi = math.acos(r) / 3.0
+    e1 = q + 2.0 * p * math.cos(phi)
+    e3 = q + 2.0 * p * math.cos(phi + 2.0 * math.pi / 3.0)
+    return e1, e3

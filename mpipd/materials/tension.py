@@ -23,30 +23,7 @@ import numba
 
 from ..input.schema import fail, join, non_negative, positive
 from ..kernels.layout import MODE_TENSION
-
-
-@numba.njit(cache=True, inline="always")
-def principal_max_min(a00, a11, a22, a12, a02, a01):
-    """Largest and smallest eigenvalue of a symmetric 3x3 matrix (closed form)."""
-    p1 = a01 * a01 + a02 * a02 + a12 * a12
-    q = (a00 + a11 + a22) / 3.0
-    b00, b11, b22 = a00 - q, a11 - q, a22 - q
-    p2 = b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * p1
-    if p2 <= 1e-300:
-        return q, q
-    p = math.sqrt(p2 / 6.0)
-    det = (b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02)
-           + a02 * (a01 * a12 - b11 * a02))
-    r = det / (2.0 * p * p * p)
-    if r <= -1.0:
-        phi = math.pi / 3.0
-    elif r >= 1.0:
-        phi = 0.0
-    else:
-        phi = math.acos(r) / 3.0
-    e1 = q + 2.0 * p * math.cos(phi)
-    e3 = q + 2.0 * p * math.cos(phi + 2.0 * math.pi / 3.0)
-    return e1, e3
+from ..kernels.linalg import principal_max_min
 
 
 @numba.njit(cache=True, inline="always")
