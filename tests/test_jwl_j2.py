@@ -76,3 +76,45 @@ def test_j2_yields_at_yield_stress_and_unloads_elastically():
     assert sigma[0, :3].mean() == pytest.approx(130e9 * tr, rel=1e-9)
     taus, _, _ = j2_shear(steps=6000, unload_at=5000)
     assert taus[5001] - taus[5000] == pytest.approx(-2 * 45e9 * 1000.0 * 1e-8, rel=1e-9)
+
+
+@pytest.mark.parametrize("eta", [0.0, 1.0 / 3.0, -1.0 / 3.0, 2.0 / 3.0])
+def test_johnson_cook_damage_fails_at_the_closed_form_strain(eta):
+    """Pure shear at a constant rate g on a point held at the mean stress eta sigma_y
+    (tr d = 0 keeps it): after yield every step adds deps_p = (2 g / sqrt 3) dt at
+    the triaxiality eta, so the point fails (mode 4, stress zeroed) once eps_p
+    passes eps_f = (d1 + d2 exp(d3 eta)) (1 + d4 ln(2 g / sqrt 3 / rate0)) —
+    Johnson & Cook (1985), computed here, within the one step that crosses it."""
+    from mpipd.kernels.layout import MODE_DUCTILE
+    from mpipd.materials.ductile import DuctileFailure
+    jc = DuctileFailure()
+    m = J2(failure=jc)
+    g, dt = 2.0e4, 1e-8
+    rate = 2.0 * g / math.sqrt(3.0)
+    ef = (jc.d1 + jc.d2 * math.exp(jc.d3 * eta)) * (1.0 + jc.d4 * math.log(rate / jc.rate0))
+    sigma = np.zeros((1, 6))
+    sigma[0, :3] = eta * m.yield_stress
+    mode = np.zeros(1, np.uint8)
+    st = m.new_state(1)
+    idx = np.zeros(1, np.int64)
+    d = np.array([[0.0, 0, 0, 0, 0, g]])
+    steps = 0
+    while mode[0] == 0 and steps < 10 ** 6:
+        m.update(idx, d, np.ones(1), dt, sigma, mode, st)
+        steps += 1
+    assert mode[0] == MODE_DUCTILE and np.all(sigma[0] == 0.0) and st["D_jc"][0] == 1.0
+    # the elastic shear strain before yield (sigma_y / sqrt 3 / 2G) carries no damage
+    assert st["eps_p"][0] == pytest.approx(ef, abs=rate * dt * 1.01)
+    # without the failure model the same path never fails
+    m0, mode0, st0, s0 = J2(), np.zeros(1, np.uint8), J2().new_state(1), np.zeros((1, 6))
+    for _ in range(steps + 100):
+        m0.update(idx, d, np.ones(1), dt, s0, mode0, st0)
+    assert mode0[0] == 0 and "D_jc" not in st0 and not m0.can_fail and m.can_fail
+
+
+def test_johnson_cook_damage_refuses_bad_constants():
+    from mpipd.input import scene as sc
+    from mpipd.input.schema import SceneError
+    for bad, key in (("{rate0=0}", "rate0"), ("{d1=-5.0}", "d1"), ("{e1=1}", "e1")):
+        with pytest.raises(SceneError, match=f"materials.copper.failure.{key}"):
+            sc.load("blast_demo", [f"materials.copper.failure={bad}"])
