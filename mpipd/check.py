@@ -406,8 +406,8 @@ def class_report(scene, table, bonds, part_dt) -> list[str]:
     bnd = [int(bonds[of_layer == k].sum()) for k in range(top + 1)]
     cost = projected_cost(bnd)
     lines = [f"  multi-rate: max_ratio {mr.max_ratio}, safety {mr.safety:g}; classes at rest "
-             "(before the one-family buffer next to a finer class and the state's refinement, "
-             "which the run applies):"]
+             "(before the one-family buffer next to a finer class and the state's refinement "
+             "by compression, smallest stretch and fracture, which the run applies):"]
     for k in range(top + 1):
         names = [q.name for q, c in zip(scene.parts, ks) if c == k]
         lines.append(f"    class {k} (dt x {2 ** k}): {pts[k]} points, {bnd[k]} bonds"

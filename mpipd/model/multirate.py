@@ -47,8 +47,12 @@ must take the fine class before it gets there), and lambda_i = min(1, smallest
 principal stretch of V_i) (``kernels.classes.min_stretch``): dt_c,i is the transit
 of the reference spacing, and a point thinned to lambda of it in one direction
 has its wave cross the spacing in lambda times the time (Courant-Friedrichs-Lewy
-on the current configuration; a copper tube driven to 2.4 x its radius is
-thinned to lambda = 0.25, docs/validation_notes.md §13).  A point whose dt_i is
+on the current configuration).  That is exact for an isochoric thinning, the
+plastic flow of a metal (the density and c are unchanged; a 1-D element of length
+lambda L with A = A0 / lambda has the stiffness k0 / lambda^2, so omega_max and
+1/dt_crit scale with 1/lambda); under compression c(state) and lambda both count
+it, which errs on the safe side.  A copper tube driven to 2.4 x its radius is
+thinned to lambda = 0.25 (docs/validation_notes.md §13).  A point whose dt_i is
 below dt itself cannot be helped by any class (class 0 is dt): the boundary
 counts it (``over``), and the run log and the error of an unstable run name the
 worst such point; the scene's remedy is a smaller dt with a larger max_ratio
