@@ -20,7 +20,7 @@ from mpipd.kernels.layout import MODE_LABELS
 from .plotting import borehole, pyplot, save
 from .sections import NAMED, section_images
 
-MODE_COLORS = ("#d9d9d9", "#d62728", "#1f77b4", "#2ca02c", "#ff7f0e")
+MODE_COLORS = ("#d9d9d9", "#d62728", "#1f77b4", "#2ca02c")
 
 
 def _draw_section(ax, sec, key, model, **style):
@@ -89,7 +89,7 @@ def failure_modes(data, model, times, last, label, out) -> str:
     lv = data["levels"]
     names = [n for n in (NAMED[0], NAMED[2], NAMED[4]) if n in lv]
     cmap = ListedColormap(MODE_COLORS)
-    norm = BoundaryNorm(np.arange(-0.5, len(MODE_COLORS)), cmap.N)
+    norm = BoundaryNorm(np.arange(-0.5, 4.5), cmap.N)
     fig, axes = plt.subplots(1, len(names), squeeze=False, figsize=(3.0 * len(names), 3.9))
     for j, name in enumerate(names):
         sec = data["sections"][name]

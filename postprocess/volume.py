@@ -17,7 +17,7 @@ rank reads one frame of one field of its own slice at a time).
   along the borehole).  With the ``gas_force`` field both take only the gas points
   that act at the frame: a passive point keeps the pressure it stopped acting at.
 * Failure modes (Fig. 13): rock points per failure_mode at the last frame
-  (0 intact, 1 JH2 plastic, 2 JH2 tensile, 3 tension model, 4 ductile).
+  (0 intact, 1 JH2 plastic, 2 JH2 tensile, 3 tension model).
 * Gas containment, per frame, from the ``u`` field: the explosive's points whose
   current position lies inside the rock, R_b + wall_dx/2 < r < R_o and z0 < z < z1
   (more than half a rock spacing beyond the borehole wall, within the specimen),
@@ -224,7 +224,7 @@ def _failure_modes(run, rock) -> dict:
         return {MODE_LABELS[i]: int(cnt[i]) for i in range(N_MODES)}
     if "failed_points_by_mode" in run.f.attrs:
         cnt = run.f.attrs["failed_points_by_mode"]
-        out = {MODE_LABELS[i]: int(cnt[i]) for i in range(min(len(cnt), N_MODES))}
+        out = {MODE_LABELS[i]: int(cnt[i]) for i in range(N_MODES)}
         out["note"] = "whole model, from the file's failed_points_by_mode"
         return out
     return {"not_available": "no failure_mode field or attribute"}

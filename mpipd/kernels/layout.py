@@ -60,11 +60,10 @@ INTACT = 0
 MODE_PLASTIC = 1        # JH2: damage D reached 1
 MODE_TENSILE = 2        # JH2: p* < -T*
 MODE_TENSION = 3        # the rate-dependent tension model (Eqs. 37–38)
-MODE_DUCTILE = 4        # a metal's Johnson-Cook damage reached 1 (materials.ductile)
 #: short name of each mode, index = mode (the CLI's summary line)
-MODE_NAMES = ("intact", "JH2 plastic", "JH2 tensile", "tension model", "ductile")
+MODE_NAMES = ("intact", "JH2 plastic", "JH2 tensile", "tension model")
 #: label of each mode with its criterion, index = mode (figures, report keys)
 MODE_LABELS = ("intact", "JH2 plastic (D >= 1)", "JH2 tensile (p < -T)",
-               "tension model (Eq. 38)", "ductile (Johnson-Cook D >= 1)")
+               "tension model (Eq. 38)")
 #: the number of modes including INTACT (length of a count vector)
-N_MODES = 5
+N_MODES = 4

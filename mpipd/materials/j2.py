@@ -8,10 +8,7 @@ radial return of the deviator onto the yield surface:
 
 with the pressure integrated elastically (K tr(d) dt); the paper applies no EOS
 to the copper.  Defaults: the paper's copper, rho 8960 kg/m^3, K 130 GPa,
-G 45 GPa, sigma_y 450 MPa.  Optionally (``failure``, not in the paper) the
-Johnson–Cook damage of :mod:`.ductile` accumulates over deps_p, at the
-triaxiality sigma_m / sigma_y of the returned stress and the rate deps_p / dt, and
-fails the point at D >= 1.
+G 45 GPa, sigma_y 450 MPa.
 """
 from __future__ import annotations
 
@@ -20,23 +17,18 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..input.schema import join, positive, tagged
-from ..kernels.layout import MODE_DUCTILE
+from ..input.schema import positive, tagged
 from ..kernels.plasticity import deviatoric_rate, radial_return, trial_deviator, von_mises
 from . import MATERIALS
 from .base import Material
-from .ductile import DuctileFailure, failure_strain
 from .heterogeneity import DISTRIBUTIONS
 from .tension import TensionFailure
 
 
 @numba.njit(cache=True)
-def j2_update(idx, d, dt, sigma, mode, eps_p, K, G, sy, D, jc):
-    """Advance the unrotated stress of the points ``idx`` (eps_p, D: compact, entry k
-    of point idx[k]); the radial return is mpipd.kernels.plasticity's.  ``jc``: the
-    Johnson–Cook constants (d1, d2, d3, d4, rate0) of mpipd.materials.ductile, or
-    empty for no failure (D is then not touched)."""
-    damage = jc.shape[0] > 0
+def j2_update(idx, d, dt, sigma, mode, eps_p, K, G, sy):
+    """Advance the unrotated stress of the points ``idx`` (eps_p: compact, entry k
+    of point idx[k]); the radial return is mpipd.kernels.plasticity's."""
     for k in range(idx.shape[0]):
         i = idx[k]
         if mode[i] != 0:
@@ -47,17 +39,7 @@ def j2_update(idx, d, dt, sigma, mode, eps_p, K, G, sy, D, jc):
         seq = von_mises(s)
         if seq > sy:
             s = radial_return(s, seq, sy)
-            deps = (seq - sy) / (3.0 * G)
-            eps_p[k] += deps
-            if damage:
-                ef = failure_strain(p_new / sy, deps / dt, jc[0], jc[1], jc[2], jc[3], jc[4])
-                D[k] = D[k] + deps / ef if ef > 0.0 else 1.0
-                if D[k] >= 1.0:
-                    D[k] = 1.0
-                    mode[i] = MODE_DUCTILE
-                    for c in range(6):
-                        sigma[i, c] = 0.0
-                    continue
+            eps_p[k] += (seq - sy) / (3.0 * G)
         sigma[i, 0] = s[0] + p_new
         sigma[i, 1] = s[1] + p_new
         sigma[i, 2] = s[2] + p_new
@@ -75,33 +57,15 @@ class J2(Material):
     shear_modulus: float = 45e9
     yield_stress: float = 450e6
     tension: TensionFailure | None = None
-    failure: DuctileFailure | None = None
     heterogeneity: object = tagged(DISTRIBUTIONS, default=None)
 
     def check(self, path):
         super().check(path)
         positive(self, path, "yield_stress")
-        if self.failure is not None:
-            self.failure.check(join(path, "failure"))
-
-    @property
-    def can_fail(self) -> bool:
-        return self.tension is not None or self.failure is not None
 
     def new_state(self, n: int) -> dict:
-        out = {"eps_p": np.zeros(n)}
-        if self.failure is not None:
-            out["D_jc"] = np.zeros(n)               # Johnson-Cook damage (no output field)
-        return out
+        return {"eps_p": np.zeros(n)}
 
     def update(self, idx, d, J, dt, sigma, mode, state):
-        if self.failure is None:
-            D, jc = NO_DAMAGE, NO_DAMAGE
-        else:
-            D, jc = state["D_jc"], np.array(self.failure.constants)
         j2_update(idx, d, dt, sigma, mode, state["eps_p"], self.bulk_modulus,
-                  self.shear_modulus, self.yield_stress, D, jc)
-
-
-#: the damage and constants passed when there is no failure model
-NO_DAMAGE = np.zeros(0)
+                  self.shear_modulus, self.yield_stress)

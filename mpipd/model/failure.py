@@ -2,7 +2,7 @@
 
 Built only when some material of the scene can fail (JH2, or a tension model).
 Every step, after the materials and the tension model have marked failed
-owned points in ``mode`` (1 JH2 plastic, 2 JH2 tensile, 3 tension model, 4 ductile):
+owned points in ``mode`` (1 JH2 plastic, 2 JH2 tensile, 3 tension model):
 
 1. the halo copies ``mode`` to the ghosts (one uint8 per point);
 2. points that failed since the last step — owned or ghost — are looked up in a
@@ -28,7 +28,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.breakage import break_bonds, pairs_from_lists, pd_damage
-from ..kernels.layout import N_MODES
 from ..state import LOCAL
 
 
@@ -130,4 +129,4 @@ class Failure:
 
     def counts(self) -> np.ndarray:
         """Owned failed points per mode (index = mode)."""
-        return np.bincount(self.mode[: self.points.n_owned], minlength=N_MODES)
+        return np.bincount(self.mode[: self.points.n_owned], minlength=4)
