@@ -20,12 +20,14 @@
 #   (the four rows before it ran with the gas acting on the copper only: case paper_coupling)
 # blast_paper_contained (0242812, the full 0.8 mm scene with the contained gas, notes §13): mpirun -n 2 mpipd run blast_paper
 #   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_contained
+# blast_paper_dx1.2_gas_contact (b3790a0, the contact with the stretch-following classes, notes §14):
+#   mpirun -n 2 mpipd run blast_paper:gas_contact --set parts.2.dx=1.2e-3 --out runs/blast_paper_dx1.2_gas_contact
 # The record of 2026-12-03 (notes §12) was made from report folders for the four copper-only
 #   rows, whose run files were not on the machine: runs/rows/<case> = docs/validation/<case>
-#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them.
+#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them; the record of 2026-12-04 (notes §14) from report folders for all eight earlier rows (runs/rows/<case> = docs/validation/<case> at 19b1ac2) and runs/blast_paper_dx1.2_gas_contact/report.
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
-    runs/blast_paper_contained/run.h5 \
+    runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
