@@ -135,7 +135,6 @@ class StepClasses:
         self.over_first = -1
         self.over_worst = {}                            # material id -> (dt_i / dt, gid)
         self.over_now = 0                               # points over dt at the last boundary
-        self.gid = points.gid[:n]
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -231,7 +230,7 @@ class StepClasses:
             min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
             now[idx] = self.dtc[idx] * lam * self.cp0[idx] / c_now / self.dt
             r[idx] = self.safety * now[idx] * c_now / c
-        self._count_over(now, corr.points.material[:n], step)
+        self._count_over(now, corr.points.material[:n], corr.points.gid, step)
         with np.errstate(divide="ignore"):
             down = np.floor(np.log2(np.maximum(r, 1e-300)))
             up = np.floor(np.log2(np.maximum(r / HYSTERESIS, 1e-300)))
@@ -243,7 +242,7 @@ class StepClasses:
         k[step - self.touched <= RECENT * self.ratio] = 0
         return k
 
-    def _count_over(self, ratio, material, step: int):
+    def _count_over(self, ratio, material, gid, step: int):
         """Book the owned points whose stable step now, dt_i = ratio * dt, is below dt
         (the extrapolated compression of the class rule aside: what holds now)."""
         over = np.flatnonzero(ratio < 1.0)
@@ -257,7 +256,7 @@ class StepClasses:
             sel = over[material[over] == m]
             w = sel[np.argmin(ratio[sel])]
             if ratio[w] < self.over_worst.get(int(m), (np.inf,))[0]:
-                self.over_worst[int(m)] = (float(ratio[w]), int(self.gid[w]))
+                self.over_worst[int(m)] = (float(ratio[w]), int(gid[w]))
 
     def over_line(self, team, names) -> str | None:
         """One line (collective) on the points whose stable step fell below dt in this
