@@ -269,3 +269,75 @@ def test_a_thinned_point_takes_a_finer_class_and_one_beyond_dt_is_named():
     assert cl.over_now == 1
     line = cl.over_line(sim.team, names)
     assert f"{names[sim.points.material[900]]} 0.500 dt at gid {int(sim.points.gid[900])}" in line
+
+
+def bar_at_rest_ratio(r0, ratio):
+    """The bar with classes from the state (safety 1) and dt set so that every point's
+    ratio at rest is ``r0``."""
+    from mpipd.check import stable_dt
+    probe = sc.load("elastic_wave", BAR + ["time.dt=1e-8", "time.t_end=1.6e-6"])[0]
+    dt = min(stable_dt(probe.parts[0], probe.materials[probe.parts[0].material])) / r0
+    scene, _ = sc.load("elastic_wave", BAR + [f"time.dt={dt}", f"time.t_end={80 * dt}",
+                                               f"time.multirate={{max_ratio={ratio}, safety=1.0}}"])
+    return Simulation(scene, _team())
+
+
+def test_a_refined_point_at_rest_returns_to_its_class_at_rest():
+    """Hysteresis never holds a point out of its class at rest: with the ratio at
+    rest r0 = 4.35 (blast_paper's 0.8 mm granite, ratio 4) a point once refined to
+    class 1 coarsens back to 2 at rest, where HYSTERESIS x 4 = 5 alone would hold it
+    at 1 for ever; between 4 and halfway to r0 it keeps the class it has (no flicker)."""
+    from mpipd.model.multirate import HYSTERESIS, coarsening_margin
+    assert np.allclose(coarsening_margin([4.35, 13.0, 40.0, 0.5, 2.9], 3),
+                       [(1 + 4.35 / 4) / 2, HYSTERESIS, HYSTERESIS, 1.0, (1 + 2.9 / 2) / 2])
+    sim = bar_at_rest_ratio(4.35, 4)
+    cl, corr = sim.classes, sim.corr
+    n = sim.points.n_owned
+    assert np.all(cl.klass[:n] == 2)
+    rng = np.random.default_rng(5)
+    lam = 4.1 / 4.35                                  # r = 4.1: above 4, below 4.175
+    for i in (300, 700):
+        q = _rotation(rng)
+        corr.V[i] = q @ np.diag([1.0, lam, 1.0]) @ q.T
+    cl.kbase[:n] = 2
+    cl.kbase[[100, 300]] = 1                          # refined once; 700 was not
+    k = cl.base_classes(corr, step=8)
+    assert k[100] == 2                                # at rest: back to its class
+    assert k[300] == 1 and k[700] == 2               # r = 4.1 keeps what it had
+    assert np.all(np.delete(k, [300]) == 2)
+
+
+def test_a_point_that_lost_half_its_family_steps_finer_by_its_shape_tensor():
+    """kappa = sqrt(lambda_min(K) / lambda_min(K0)) (mpipd.model.multirate): in a bar
+    whose points take class 3 at rest, a bulk point whose bonds on one side (+x) are
+    broken takes floor(log2(r0 kappa)), with K and K0 summed here from the bonds
+    (quadratic influence, Eq. 4) and their eigenvalues from numpy; its intact
+    neighbours keep kappa = 1, and a failed point's kappa is 1."""
+    sim = bar_at_rest_ratio(10.0, 8)
+    cl, corr, p, fam = sim.classes, sim.corr, sim.points, sim.families
+    n = p.n_owned
+    r0 = cl.safety * cl.dtc[0] / sim.dt
+    assert np.all(cl.klass[:n] == 3) and r0 == pytest.approx(10.0)
+    centre = np.array([0.048, 0.003, 0.003])
+    i = int(np.argmin(np.linalg.norm(p.x[:n] - centre, axis=1)))
+    nb = np.arange(fam.offsets[i], fam.offsets[i + 1])
+    xi = p.x[fam.nbr[nb]] - p.x[i]
+    cut = nb[xi[:, 0] > 1e-9]
+    fam.broken[cut] = 1
+    cl.touch(np.array([i]))
+    corr.rebuild_shape(np.array([i]))
+
+    def kmin(keep):
+        e = xi[keep]
+        w = (p.horizon[i] - np.linalg.norm(e, axis=1)) ** 2 * p.volume[fam.nbr[nb[keep]]]
+        return np.linalg.eigvalsh(np.einsum("b,bi,bj->ij", w, e, e))[0]
+    kappa = np.sqrt(kmin(xi[:, 0] <= 1e-9) / kmin(np.ones(len(nb), bool)))
+    assert 0.2 < kappa < 0.8                          # measured sqrt(1/2): K_xx halved
+    got = cl.family_factor(corr)
+    assert got[i] == pytest.approx(kappa, rel=1e-9)
+    assert np.all(np.delete(got, i) == 1.0)
+    k = cl.base_classes(corr, step=10_000)            # long after the breakage
+    assert k[i] == min(3, int(np.floor(np.log2(r0 * kappa)))) == 2
+    from mpipd.kernels.layout import MODE_TENSION
+    corr.mode[i] = MODE_TENSION
+    assert cl.family_factor(corr)[i] == 1.0

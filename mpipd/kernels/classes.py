@@ -52,3 +52,13 @@ def min_stretch(V, idx, spring, mode, out):
             if lam < 1e-6:
                 lam = 1e-6
         out[k] = lam
+
+
+@numba.njit(cache=True)
+def largest_eigenvalue(A, out):
+    """out[i] = the largest eigenvalue of the symmetric 3x3 A[i] (its symmetric part)."""
+    for i in range(A.shape[0]):
+        out[i], _ = principal_max_min(A[i, 0, 0], A[i, 1, 1], A[i, 2, 2],
+                                      0.5 * (A[i, 1, 2] + A[i, 2, 1]),
+                                      0.5 * (A[i, 0, 2] + A[i, 2, 0]),
+                                      0.5 * (A[i, 0, 1] + A[i, 1, 0]))

@@ -345,6 +345,9 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
         hi = fd[i, FD_H]
         di = horizon[i]
         si = fd[i, FD_SPRING]
+        li = fd[i, FD_VISC_L] if visc else 0.0
+        qi = fd[i, FD_VISC_Q] if visc else 0.0
+        vi_on = li != 0.0 or qi != 0.0
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
         for k in range(offsets[i], offsets[i + 1]):
@@ -355,8 +358,7 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
-            # |xi| only where a term needs it (the viscosity, a spring, contact)
-            r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) if visc else 0.0
+            r = 0.0                     # |xi| only where a term needs it
             kj = klass[j]
             if broken[k]:
                 if contact and min(ki, kj) <= level:
@@ -394,8 +396,10 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
                     tx += g * y0
                     ty += g * y1
                     tz += g * y2
-            if visc:
-                c = viscous_bond(w_i, w_j, fd[i, FD_VISC_L], fd[i, FD_VISC_Q], fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
+            # the viscosity, where either end is being compressed (else its term is 0)
+            if visc and (vi_on or fd[j, FD_VISC_L] != 0.0 or fd[j, FD_VISC_Q] != 0.0):
+                r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+                c = viscous_bond(w_i, w_j, li, qi, fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
                                  v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
                                  e0, e1, e2, r)
                 cv = c * vol[j]

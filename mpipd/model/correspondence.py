@@ -262,6 +262,18 @@ class Correspondence(Model):
         self.n_spring = self.count_spring()
         return self.n_spring
 
+    def reference_kinv(self) -> np.ndarray:
+        """K^-1 (Eq. 4) of every owned point over its whole reference family (no bond
+        broken; zero where K cannot be inverted), without touching the model's state."""
+        p, fam = self.points, self.families
+        n = p.n_owned
+        Kinv = np.zeros((n, 3, 3))
+        spring = np.zeros(n, np.uint8)
+        nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
+                           np.zeros_like(fam.broken), Kinv, np.zeros(n), np.zeros(n), spring,
+                           RCOND, np.arange(n, dtype=np.int64))
+        return Kinv
+
     def count_spring(self) -> int:
         """Owned total-Lagrangian points on the bond-spring fallback."""
         return int(np.count_nonzero((self.spring == SPRING_K) | (self.spring == SPRING_F)))

@@ -32,7 +32,7 @@ Darve & Lew 2008, JCP 227, for the stability analysis):
 Class rule (at every coarse boundary, identical on any number of ranks: a
 function of each point's own state, then of its family by halo exchange):
 
-    dt_i = dt_c,i * lambda_i * c_p,i / c_i(state)        (the point's stable step now;
+    dt_i = dt_c,i * lambda_i * kappa_i * c_p,i / c_i(state)   (the stable step now;
                                                           dt_c,i: mpipd.check.stable_dt
                                                           of the point's part; c_p,i its
                                                           reference P-wave speed)
@@ -51,14 +51,22 @@ on the current configuration).  That is exact for an isochoric thinning, the
 plastic flow of a metal (the density and c are unchanged; a 1-D element of length
 lambda L with A = A0 / lambda has the stiffness k0 / lambda^2, so omega_max and
 1/dt_crit scale with 1/lambda); under compression c(state) and lambda both count
-it, which errs on the safe side.  A copper tube driven to 2.4 x its radius is
+it, which errs on the safe side.  kappa_i = min(1, sqrt(lambda_min(K_i) /
+lambda_min(K_i^0))) follows the family (``StepClasses.family_factor``): the force
+state omega P K^-1 xi, with P linear in F = N K^-1, makes the element's stiffness
+scale with K^-1, its largest eigenvalue with 1 / lambda_min(K), and so its stable
+step with lambda_min(K)^1/2; a point whose family lost the bonds on one side (a
+crack face, the crushed zone) steps finer for as long as it stays so.  A copper tube driven to 2.4 x its radius is
 thinned to lambda = 0.25 (docs/validation_notes.md §13).  A point whose dt_i is
 below dt itself cannot be helped by any class (class 0 is dt): the boundary
 counts it (``over``), and the run log and the error of an unstable run name the
 worst such point; the scene's remedy is a smaller dt with a larger max_ratio
 (the same coarse step).  Coarsening needs
-``HYSTERESIS`` x the margin (no class flicker at a threshold); refining is
-immediate.  The buffer makes every element's class no coarser than any point
+``HYSTERESIS`` x the margin (no class flicker at a threshold), but never more
+than half the point's own margin at rest (``coarsening_margin``): a point whose
+ratio at rest lies less than HYSTERESIS above its class's threshold (the 0.8 mm
+granite of blast_paper: 4.35 against 4) would otherwise never return to it once
+refined.  Refining is immediate.  The buffer makes every element's class no coarser than any point
 it pushes.  When a class changes, the forces at the boundary are gathered
 again with the new weights (the second half kick of velocity Verlet with a
 changed step), and the jump of the integrator term this makes is booked in
@@ -68,7 +76,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import family_min, min_stretch
+from ..kernels.classes import family_min, largest_eigenvalue, min_stretch
+from ..kernels.layout import CORRESPONDENCE, INTACT
 from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
@@ -135,12 +144,15 @@ class StepClasses:
         self.over_first = -1
         self.over_worst = {}                            # material id -> (dt_i / dt, gid)
         self.over_now = 0                               # points over dt at the last boundary
+        #: family_factor: 1/lambda_min(K^0), the factor kept, the rows to recompute
+        self.kref = self.kfac = self.stale = None
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
             self.dtc = dtc[points.part[:n]]
             self.cp0 = cp[points.part[:n]]
+            self.hyst = coarsening_margin(self.safety * self.dtc / self.dt, self.top)
 
     @property
     def fam_bonds(self) -> np.ndarray:
@@ -209,6 +221,31 @@ class StepClasses:
         Failure.on_rebuild)."""
         if len(rows):
             self.touched[rows] = self.step
+            if self.kfac is not None:
+                self.stale[rows] = True
+
+    def family_factor(self, corr) -> np.ndarray:
+        """kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) of every owned
+        point (K: Eq. 4 over the intact bonds, K^0 over the whole reference family),
+        1 off the correspondence force or once failed (module docstring).  Kept per
+        point and recomputed where the family changed (:meth:`touch`)."""
+        n = self.n_owned
+        if self.kfac is None:                           # first use, or after a restart
+            self.kref = np.empty(n)
+            largest_eigenvalue(corr.reference_kinv(), self.kref)    # 1 / lambda_min(K^0)
+            self.kfac = np.ones(n)
+            self.stale = np.ones(n, bool)
+        rows = np.flatnonzero(self.stale)
+        if len(rows):
+            e = np.empty(len(rows))
+            largest_eigenvalue(corr.Kinv[rows], e)                  # 1 / lambda_min(K)
+            ok = e > 0.0
+            f = np.ones(len(rows))
+            f[ok] = np.sqrt(self.kref[rows[ok]] / e[ok])
+            self.kfac[rows] = np.minimum(1.0, f)
+            self.stale[rows] = False
+        on = (corr.spring[:n] == CORRESPONDENCE) & (corr.mode[:n] == INTACT)
+        return np.where(on, self.kfac, 1.0)
 
     def base_classes(self, corr, step: int = 0) -> np.ndarray:
         """Each owned point's class from its own material and state (module docstring)."""
@@ -218,6 +255,7 @@ class StepClasses:
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
         now = np.full(n, np.inf)                        # dt_i / dt at the state now
         horizon = 2.0 * self.ratio * self.dt
+        kappa = self.family_factor(corr)
         for g in corr.groups:
             idx = g.idx
             mu = 1.0 / corr.J_end[idx] - 1.0
@@ -228,12 +266,13 @@ class StepClasses:
             c = np.maximum(c_now, g.material.p_wave_speed_at(mu_ahead))
             lam = np.empty(len(idx))
             min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
+            lam *= kappa[idx]
             now[idx] = self.dtc[idx] * lam * self.cp0[idx] / c_now / self.dt
             r[idx] = self.safety * now[idx] * c_now / c
         self._count_over(now, corr.points.material[:n], corr.points.gid, step)
         with np.errstate(divide="ignore"):
             down = np.floor(np.log2(np.maximum(r, 1e-300)))
-            up = np.floor(np.log2(np.maximum(r / HYSTERESIS, 1e-300)))
+            up = np.floor(np.log2(np.maximum(r / self.hyst, 1e-300)))
         down = np.clip(down, 0, self.top).astype(np.uint8)
         up = np.clip(up, 0, self.top).astype(np.uint8)
         k = np.minimum(down, np.maximum(self.kbase[:n], up))
@@ -343,6 +382,19 @@ class StepClasses:
             sel = k == c
             out[c] = (int(sel.sum()), int(n_bonds_of[sel].sum()))
         return out
+
+
+def coarsening_margin(rest, top: int) -> np.ndarray:
+    """The factor above a class's threshold 2^k that a point's ratio r must reach to
+    coarsen into class k: HYSTERESIS, or half the point's margin at rest if that is
+    smaller,  h = clip((1 + m) / 2, 1, HYSTERESIS)  with m = r_rest / 2^k_rest and
+    k_rest = clip(floor(log2 r_rest), 0, top) the class the point takes at rest
+    (``rest``: r_rest of each point, its ratio at rest).  A point at rest is then
+    always back in its class at rest."""
+    rest = np.asarray(rest, float)
+    with np.errstate(divide="ignore"):
+        k = np.clip(np.floor(np.log2(np.maximum(rest, 1e-300))), 0, top)
+    return np.clip(0.5 * (1.0 + rest / 2.0 ** k), 1.0, HYSTERESIS)
 
 
 def projected_cost(bonds_per_class) -> float:
