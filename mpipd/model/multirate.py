@@ -353,7 +353,9 @@ class StepClasses:
                                           minlength=self.top + 1).tolist()
 
     def after_restore(self, halo):
-        """Ghost classes and receivers from the restored owned classes."""
+        """Ghost classes and receivers from the restored owned classes; the family
+        factors are taken again from the restored shape tensors at the next boundary."""
+        self.kfac = None
         if self.enabled:
             fam = self.families
             halo.exchange(self.klass, self.kbase)
