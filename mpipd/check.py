@@ -407,7 +407,7 @@ def class_report(scene, table, bonds, part_dt) -> list[str]:
     cost = projected_cost(bnd)
     lines = [f"  multi-rate: max_ratio {mr.max_ratio}, safety {mr.safety:g}; classes at rest "
              "(before the one-family buffer next to a finer class and the state's refinement "
-             "by compression, smallest stretch and fracture, which the run applies):"]
+             "by compression, smallest stretch, the family left and fracture, which the run applies):"]
     for k in range(top + 1):
         names = [q.name for q, c in zip(scene.parts, ks) if c == k]
         lines.append(f"    class {k} (dt x {2 ** k}): {pts[k]} points, {bnd[k]} bonds"
