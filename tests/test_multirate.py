@@ -176,9 +176,9 @@ def test_state_following_classes_and_the_ledger():
     k = sim.classes.klass[:n]
     assert e.multirate != 0.0                    # classes changed and the jump was booked
     assert np.all(k[(r < 0.006) & (sim.mode[:n] == 0)] < 2)   # the crushed zone went fine
-    assert bal < 1e-4                            # measured 3.1e-5 (single-rate: 1.7e-6)
+    assert bal < 1e-4                            # measured 4.2e-5 (single-rate: 1.7e-6)
     # the multirate term is needed: without it the ledger would not close to the bound
-    assert abs(e.multirate) / e.scale > 1e-3     # measured 2.2e-3
+    assert abs(e.multirate) / e.scale > 1e-3     # measured 2.4e-3
 
 
 def test_a_probe_in_a_coarse_class_is_timed_at_its_updates():
