@@ -32,6 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 from mpipd.input import scene as sc  # noqa: E402
 from mpipd.model.ledger import Energies, impossible  # noqa: E402
+from mpipd.output.writer import short_commit  # noqa: E402
 
 
 def finished(h5: Path) -> bool:
@@ -62,7 +63,7 @@ def summary(h5: Path, rc: int) -> dict:
                  if peak is not None else {})
     wall = sum(s["wall_s"] for s in segs)
     done = sum(s["to_step"] - s["from_step"] for s in segs)
-    commits = sorted({sg["git_commit"][:10] for sg in segs})
+    commits = sorted({short_commit(sg["git_commit"], 10) for sg in segs})
     return {"exit": rc, "commits": commits, "last_step": last, "steps": steps, "reached_t_end": last == steps,
             "wall_s": wall if segs else None, "n_points": int(len(mat)),
             "bond_steps_per_s": (sum(s["bond_steps_per_s"] * s["wall_s"] for s in segs) / wall

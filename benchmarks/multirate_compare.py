@@ -35,13 +35,16 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from mpipd.output.writer import short_commit  # noqa: E402
+
 
 def read(run_dir: Path) -> dict:
     if not (run_dir / "run.h5").exists() and (run_dir / "report.json").exists():
         return read_report(run_dir / "report.json")
     with h5py.File(run_dir / "run.h5", "r") as f:
         seg = json.loads(f.attrs["segments"])
-        out = {"commit": str(f.attrs["git_commit"])[:12], "ranks": int(f.attrs["ranks"]),
+        out = {"commit": short_commit(f.attrs["git_commit"]), "ranks": int(f.attrs["ranks"]),
                "wall": sum(s["wall_s"] for s in seg), "dt": float(f.attrs["dt"]),
                "modes": [int(m) for m in f.attrs["failed_points_by_mode"]],
                "broken": int(f.attrs["bonds_broken"]),
@@ -78,7 +81,7 @@ def read_report(path: Path) -> dict:
     run, fm = j["run"], j["failure_modes"]
     modes = [fm.get(k, 0) for k in ("intact", "JH2 plastic (D >= 1)", "JH2 tensile (p < -T)",
                                      "tension model (Eq. 38)")]
-    return {"commit": str(run["git_commit"])[:12], "ranks": int(run["run_ranks"]),
+    return {"commit": short_commit(run["git_commit"]), "ranks": int(run["run_ranks"]),
             "wall": sum(s["wall_s"] for s in run.get("segments", [])), "dt": float(run["dt_s"]),
             "modes": modes, "broken": int(run["bonds_broken"]),
             "balance": float(j["energy_ledger"]["balance"][-1]),

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from mpipd.input.scene import parse
+from mpipd.output.writer import short_commit
 
 from .fragment_report import make_fragments
 from .model import split_scene_text
@@ -114,7 +115,7 @@ def bench_metrics(path, comm) -> dict:
         top = run.max_array(top)
         centres = (np.arange(nb) + 0.5) * dx
         t_end = float(run.time[last])
-        commit = str(run.attr("git_commit", ""))[:7]
+        commit = short_commit(run.attr("git_commit", ""), 7)
         peak_gas = run.attr("peak_gas_pressure", None)
         lit = run.attr("density_at_lighting", None)
         lit = json.loads(str(lit)) if lit is not None else None

@@ -4,6 +4,8 @@ dict as ``report.json``.  A value that is an error is printed as "error", never
 as a number."""
 from __future__ import annotations
 
+from mpipd.output.writer import short_commit
+
 
 def _f(v, fmt=".3g"):
     if v is None:
@@ -58,7 +60,7 @@ def render(doc) -> str:
          f"Run file `{run['run_file']}`: {run['n_points']} points, {doc['frames']} frames to "
          f"t = {doc['t_end_us']:.3g} µs (dt {_f(run['dt_s'])} s, {_f(run['steps'])} steps, "
          f"written by {_f(run['run_ranks'])} rank(s)); mpipd {run['mpipd_version']}, "
-         f"commit {run['git_commit'][:12]}.",
+         f"commit {short_commit(run['git_commit'])}.",
          f"Fields: {', '.join(run['fields']) or 'none'}.  Borehole wall R_b = "
          f"{m['r_wall_m'] * 1e3:.3g} mm (rock part `{m['rock_part']}`), outer radius R_o = "
          f"{m['r_out_m'] * 1e3:.4g} mm, thickness {(m['z_m'][1] - m['z_m'][0]) * 1e3:.4g} mm, "

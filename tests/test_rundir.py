@@ -254,3 +254,26 @@ def test_signal_stop_exits_0_with_a_checkpoint(tmp_path, how):
     stdout, stderr = p.communicate(timeout=120)
     assert p.returncode == 0, stdout + stderr
     assert "stopped at step" in stdout and (out / "checkpoint.h5").exists()
+
+
+def test_git_commit_marks_uncommitted_solver_changes(tmp_path):
+    """A run made from changed tracked files records HEAD with the dirty mark; an
+    untracked file leaves it clean; short_commit keeps the mark."""
+    import subprocess
+
+    from mpipd.output.writer import DIRTY, git_commit, short_commit
+    git = ["git", "-C", str(tmp_path), "-c", "user.name=t", "-c", "user.email=t@t"]
+    subprocess.run(git + ["init", "-q"], check=True)
+    (tmp_path / "a.py").write_text("x = 1\n")
+    subprocess.run(git + ["add", "a.py"], check=True)
+    subprocess.run(git + ["commit", "-qm", "a"], check=True)
+    head = subprocess.run(git + ["rev-parse", "HEAD"], capture_output=True, text=True,
+                          check=True).stdout.strip()
+    assert git_commit(tmp_path) == head
+    (tmp_path / "new.py").write_text("y = 2\n")                 # untracked
+    assert git_commit(tmp_path) == head
+    (tmp_path / "a.py").write_text("x = 2\n")
+    assert git_commit(tmp_path) == head + DIRTY
+    assert short_commit(head + DIRTY) == head[:12] + DIRTY
+    assert short_commit(head, 7) == head[:7]
+    assert git_commit(tmp_path / "nowhere") == "unknown"

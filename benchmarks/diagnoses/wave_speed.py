@@ -41,6 +41,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from mpipd.input.loads import BoreholePressure  # noqa: E402
 from mpipd.input.scene import parse  # noqa: E402
+from mpipd.output.writer import short_commit  # noqa: E402
 from postprocess import arrivals  # noqa: E402
 from postprocess.model import split_scene_text  # noqa: E402
 
@@ -96,7 +97,7 @@ def one(path):
     with h5py.File(path, "r") as f:
         head, sets = split_scene_text(f.attrs["scene"])
         scene = parse(head, str(path), sets)
-        commit = str(f.attrs.get("git_commit", "unknown"))[:12]
+        commit = short_commit(f.attrs.get("git_commit", "unknown"))
         x = f["geometry/x"][...]
         recs, names, r = {}, [], []
         for n in PROBES:

@@ -51,15 +51,33 @@ from ..input.scene import OUTPUT_FIELDS
 from ..kernels.linalg import VOIGT
 from ..model.ledger import DISSIPATED, HELD, TERMS
 
+#: the suffix of a commit whose solver files had uncommitted changes at run time
+DIRTY = "-dirty"
 
-def git_commit() -> str:
+
+def git_commit(where: Path | None = None) -> str:
+    """HEAD of the checkout that holds ``where`` (default: the solver package), with
+    ``DIRTY`` appended if a tracked file under ``where`` differs from it: a run made
+    from uncommitted solver code does not pass for the commit's."""
+    where = Path(where) if where is not None else Path(__file__).resolve().parents[1]
     try:
-        here = Path(__file__).resolve().parent
-        out = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"],
+        out = subprocess.run(["git", "-C", str(where), "rev-parse", "HEAD"],
                              capture_output=True, text=True, timeout=5)
-        return out.stdout.strip() if out.returncode == 0 else "unknown"
+        if out.returncode != 0:
+            return "unknown"
+        st = subprocess.run(["git", "-C", str(where), "status", "--porcelain",
+                             "--untracked-files=no", "."],
+                            capture_output=True, text=True, timeout=10)
+        dirty = st.returncode != 0 or bool(st.stdout.strip())
+        return out.stdout.strip() + (DIRTY if dirty else "")
     except (OSError, subprocess.SubprocessError):
         return "unknown"
+
+
+def short_commit(commit: str, n: int = 12) -> str:
+    """The first ``n`` characters of a recorded commit, keeping its ``DIRTY`` mark."""
+    commit = str(commit)
+    return commit[:n] + (DIRTY if commit.endswith(DIRTY) and len(commit) - len(DIRTY) > n else "")
 
 
 def n_frames(n_steps: int, every: int) -> int:
