@@ -89,7 +89,7 @@ def failure_modes(data, model, times, last, label, out) -> str:
     lv = data["levels"]
     names = [n for n in (NAMED[0], NAMED[2], NAMED[4]) if n in lv]
     cmap = ListedColormap(MODE_COLORS)
-    norm = BoundaryNorm(np.arange(-0.5, 4.5), cmap.N)
+    norm = BoundaryNorm(np.arange(-0.5, len(MODE_COLORS)), cmap.N)    # one bin per mode code
     fig, axes = plt.subplots(1, len(names), squeeze=False, figsize=(3.0 * len(names), 3.9))
     for j, name in enumerate(names):
         sec = data["sections"][name]

@@ -44,10 +44,7 @@ def min_stretch(V, idx, spring, mode, out):
         i = idx[k]
         lam = 1.0
         if spring[i] == CORRESPONDENCE and mode[i] == INTACT:
-            _, lam = principal_max_min(V[i, 0, 0], V[i, 1, 1], V[i, 2, 2],
-                                       0.5 * (V[i, 1, 2] + V[i, 2, 1]),
-                                       0.5 * (V[i, 0, 2] + V[i, 2, 0]),
-                                       0.5 * (V[i, 0, 1] + V[i, 1, 0]))
+            _, lam = _sym_max_min(V, i)
             lam = min(1.0, lam)
             if lam < 1e-6:
                 lam = 1e-6
@@ -58,7 +55,13 @@ def min_stretch(V, idx, spring, mode, out):
 def largest_eigenvalue(A, out):
     """out[i] = the largest eigenvalue of the symmetric 3x3 A[i] (its symmetric part)."""
     for i in range(A.shape[0]):
-        out[i], _ = principal_max_min(A[i, 0, 0], A[i, 1, 1], A[i, 2, 2],
-                                      0.5 * (A[i, 1, 2] + A[i, 2, 1]),
-                                      0.5 * (A[i, 0, 2] + A[i, 2, 0]),
-                                      0.5 * (A[i, 0, 1] + A[i, 1, 0]))
+        out[i], _ = _sym_max_min(A, i)
+
+
+@numba.njit(cache=True, inline="always")
+def _sym_max_min(A, i):
+    """Largest and smallest eigenvalue of the symmetric part of A[i] (3x3)."""
+    return principal_max_min(A[i, 0, 0], A[i, 1, 1], A[i, 2, 2],
+                             0.5 * (A[i, 1, 2] + A[i, 2, 1]),
+                             0.5 * (A[i, 0, 2] + A[i, 2, 0]),
+                             0.5 * (A[i, 0, 1] + A[i, 1, 0]))
