@@ -14,5 +14,12 @@ which array):
 ``cli``         ``mpipd run | check | scenes``
 
 Importing mpipd never initialises MPI; the CLI and tests pass a communicator in.
+It does point numba's kernel cache at a directory keyed by the sources
+(mpipd.kernels.cache).
 """
+from .kernels.cache import configure as _configure_kernel_cache
+
 __version__ = "0.1.0"
+
+#: numba's cache directory, keyed by the sources (mpipd.kernels.cache)
+KERNEL_CACHE = _configure_kernel_cache()

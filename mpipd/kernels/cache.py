@@ -1,0 +1,85 @@
+"""Where numba keeps the compiled kernels: one directory per version of the sources.
+
+numba's ``cache=True`` re-checks only the file that defines a function.  A kernel
+that calls a function of another module (and inlines it: ``classes.weight`` in
+``nosb.gather_forces``, ``linalg`` everywhere) keeps its cached machine code after
+that other module changes — numba's documentation lists it under the cache's
+limitations ("cache invalidation fails to recognize changes in functions defined
+in a different file"; numba issue #1833).  A run of changed code could then
+compute with the old kernels and say nothing.
+
+So :func:`configure` (called by ``import mpipd``, before any kernel is defined)
+points numba at ``<root>/<key>``, the key a hash of every ``.py`` source of mpipd
+and of ``postprocess`` beside it (names and contents): any change to any source
+starts a fresh cache, and identical sources, in any clone, share one.  The root is
+``$MPIPD_KERNEL_CACHE``, else ``$NUMBA_CACHE_DIR``, else ``$XDG_CACHE_HOME/mpipd/numba``
+(``~/.cache/mpipd/numba``).  Directories of other keys unused for ``KEEP_DAYS``
+are removed.  If the root cannot be written, numba's own locators take over (the
+cache beside the sources) and a warning says so.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import time
+import warnings
+from pathlib import Path
+
+#: the packages (beside each other) whose sources key the cache
+PACKAGES = ("mpipd", "postprocess")
+#: a key's directory unused for this many days is removed
+KEEP_DAYS = 14
+
+
+def source_key(roots) -> str:
+    """Hash of the ``.py`` files under ``roots`` (their paths relative to each root's
+    parent, and their bytes), 16 hex digits."""
+    h = hashlib.sha256()
+    for root in roots:
+        root = Path(root)
+        for p in sorted(root.rglob("*.py")):
+            h.update(p.relative_to(root.parent).as_posix().encode())
+            h.update(b"\0")
+            h.update(p.read_bytes())
+            h.update(b"\0")
+    return h.hexdigest()[:16]
+
+
+def cache_root() -> Path:
+    """The directory the keyed caches live in (module docstring)."""
+    for var in ("MPIPD_KERNEL_CACHE", "NUMBA_CACHE_DIR"):
+        if os.environ.get(var):
+            return Path(os.environ[var])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "mpipd" / "numba"
+
+
+def _prune(root: Path, keep: str) -> None:
+    """Remove the keyed directories other than ``keep`` unused for KEEP_DAYS."""
+    old = time.time() - KEEP_DAYS * 86400.0
+    for d in root.iterdir():
+        if d.name != keep and d.is_dir() and len(d.name) == 16 and d.stat().st_mtime < old:
+            shutil.rmtree(d, ignore_errors=True)
+
+
+def configure() -> Path | None:
+    """Point numba's cache at ``cache_root()/source_key(...)``; returns that directory
+    (None, with a warning, if it cannot be made)."""
+    import numba
+
+    here = Path(__file__).resolve().parents[1]            # the mpipd package
+    roots = [here.parent / name for name in PACKAGES if (here.parent / name).is_dir()]
+    key = source_key(roots)
+    root = cache_root()
+    path = root / key
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        os.utime(path)                                   # in use: not pruned
+        _prune(root, key)
+    except OSError as e:
+        warnings.warn(f"mpipd: kernel cache {path} not usable ({e}); numba caches beside "
+                      "the sources, which miss changes across modules", stacklevel=2)
+        return None
+    numba.config.CACHE_DIR = str(path)
+    return path
