@@ -492,6 +492,30 @@ def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
         assert list(n2[off[i]:off[i + 1]]) == want.get(i, [])
 
 
+@pytest.mark.parametrize("spread", [1.0, 40.0, 1.0e9])
+def test_near_cells_keeps_every_candidate_within_a_cell(spread):
+    """near_cells keeps, in order, every candidate within one cell of some ``around``
+    point (brute force here) and none beyond the farthest corner of the next cell
+    (2 sqrt 3 cells); a box too large for the cell keys drops no candidate."""
+    from mpipd.kernels.search import near_cells
+    rng = np.random.default_rng(11)
+    y = rng.uniform(-0.01, 0.01, (700, 3))
+    y[::13] *= spread
+    around = np.flatnonzero(rng.random(700) < 0.15)
+    cand = np.flatnonzero(rng.random(700) < 0.7)
+    cell = 1.5e-3
+    got = near_cells(y, cand, around, cell)
+    d = np.linalg.norm(y[cand][:, None] - y[around][None], axis=-1).min(axis=1)
+    assert set(cand[d < cell]) <= set(got) and np.all(np.diff(got) > 0)
+    if spread < 1e6:
+        assert 0 < len(got) < len(cand)
+        dg = np.linalg.norm(y[got][:, None] - y[around][None], axis=-1).min(axis=1)
+        assert dg.max() < 2.0 * np.sqrt(3.0) * cell
+    else:
+        assert np.array_equal(got, cand)
+    assert len(near_cells(y, cand, around[:0], cell)) == 0
+
+
 # ------------------------------------------------------------------ where the gas acts
 def _lattice_update(gas_mask, a=2.0e5, h=4.0e-4):
     """One gas_update on a 7 x 7 x 7 cubic lattice (spacing h, gas horizon 3h) under

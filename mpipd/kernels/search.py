@@ -1,6 +1,10 @@
 """Pair search in the current configuration by a cell list (the gas's Verlet list,
 mpipd.model.gas).
 
+Before that, :func:`near_cells` keeps only the candidates that can have a pair
+at all (a solid far from every gas point has none), so a gas that has spread over
+the specimen does not make every solid in its bounding box a candidate.
+
 The candidate points are binned into cubic cells of side ``cell`` (at least the
 largest cut-off), keyed (ix n_y + iy) n_z + iz and sorted by key; each row point
 scans the 27 cells around its own (binary search of the sorted keys; the three
@@ -11,6 +15,8 @@ row is returned sorted by neighbour gid (the order every kernel sums in).
 """
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -19,12 +25,69 @@ import numpy as np
 MAX_CELLS = 1 << 62
 
 
-def in_box(y: np.ndarray, idx: np.ndarray, around: np.ndarray, reach: float) -> np.ndarray:
-    """The points ``idx`` whose positions y lie in the bounding box of the points
-    ``around`` (positions) grown by ``reach``: no point outside it is within reach."""
-    lo, hi = around.min(axis=0) - reach, around.max(axis=0) + reach
-    yi = y[idx]
-    return idx[np.all((yi >= lo) & (yi <= hi), axis=1)]
+@numba.njit(cache=True)
+def near_cells(y, cand, around, cell):
+    """The candidates ``cand`` (local indices, order kept) whose cell of side ``cell``
+    is, or touches, a cell holding one of the points ``around`` (local indices).
+
+    A point within ``cell`` of some ``around`` point lies at most one cell from it
+    along each axis, so the result holds every candidate within ``cell`` of the
+    ``around`` points (and some a little farther: callers test the distance).  The
+    cells are keyed over the ``around`` points' bounding box grown by one cell; the
+    keys of the occupied cells and their 26 neighbours are sorted once, then each
+    candidate is one binary search: O((candidates + 27 around) log), no dense grid.
+    Where the box has too many cells for int64 keys (:data:`MAX_CELLS`) no candidate
+    is dropped."""
+    if around.shape[0] == 0:
+        return cand[:0].copy()
+    lo = np.empty(3)
+    hi = np.empty(3)
+    for c in range(3):
+        lo[c] = y[around[0], c]
+        hi[c] = lo[c]
+    for p in range(around.shape[0]):
+        for c in range(3):
+            w = y[around[p], c]
+            lo[c] = min(lo[c], w)
+            hi[c] = max(hi[c], w)
+    span = np.empty(3)             # cells along each axis, one spare on either side
+    for c in range(3):
+        span[c] = math.floor((hi[c] - lo[c]) / cell) + 3.0
+    if not span[0] * span[1] * span[2] < MAX_CELLS:
+        return cand.copy()
+    d = span.astype(np.int64)
+    occ = np.empty(around.shape[0], np.int64)
+    for p in range(around.shape[0]):
+        i = around[p]
+        ix = int(math.floor((y[i, 0] - lo[0]) / cell)) + 1
+        iy = int(math.floor((y[i, 1] - lo[1]) / cell)) + 1
+        iz = int(math.floor((y[i, 2] - lo[2]) / cell)) + 1
+        occ[p] = (ix * d[1] + iy) * d[2] + iz
+    occ = np.unique(occ)
+    grown = np.empty(27 * occ.shape[0], np.int64)
+    k = 0
+    for p in range(occ.shape[0]):
+        iz = occ[p] % d[2]
+        iy = (occ[p] // d[2]) % d[1]
+        ix = occ[p] // (d[1] * d[2])
+        for a in range(ix - 1, ix + 2):
+            for b in range(iy - 1, iy + 2):
+                for c in range(iz - 1, iz + 2):
+                    grown[k] = (a * d[1] + b) * d[2] + c
+                    k += 1
+    grown = np.unique(grown)
+    keep = np.zeros(cand.shape[0], np.bool_)
+    for q in range(cand.shape[0]):
+        j = cand[q]
+        gx = math.floor((y[j, 0] - lo[0]) / cell) + 1.0     # as floats: no overflow
+        gy = math.floor((y[j, 1] - lo[1]) / cell) + 1.0
+        gz = math.floor((y[j, 2] - lo[2]) / cell) + 1.0
+        if not (0.0 <= gx < span[0] and 0.0 <= gy < span[1] and 0.0 <= gz < span[2]):
+            continue
+        key = (int(gx) * d[1] + int(gy)) * d[2] + int(gz)
+        s = np.searchsorted(grown, key)
+        keep[q] = s < grown.shape[0] and grown[s] == key
+    return cand[keep]
 
 
 def cell_counts(y_el: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:

@@ -38,7 +38,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
-from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, in_box, max_moved2, merge_rows
+from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows, near_cells
 from ..kernels.ul import gas_contact_energy, gas_gather, gas_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
@@ -230,25 +230,26 @@ class Gas(Model):
     def _pairs(self, ye, n):
         """The families at positions ``ye`` (local + remote rows): each owned gas point
         among every candidate (gas and solids), each owned solid among the gas only
-        (a solid-solid pair carries no force); solids outside the gas's bounding box
-        grown by the reach plus the skin cannot pair and are skipped."""
+        (a solid-solid pair carries no force).  Only the solids in or next to a cell
+        (side: reach plus skin) that holds gas can pair (:func:`near_cells`); the
+        others are skipped, however far the gas has spread."""
         el, gas = self.el_ext, self.gas_all
         if not len(self.rows) or not len(gas):
             self.offsets[:] = 0
             self.nbr = np.zeros(0, np.int32)
             return
         cell = self.reach + self.skin
-        yg = ye[gas]
-        el = in_box(ye, el, yg, cell)
+        solids = near_cells(ye, el[self.isgas_ext[el] == 0], gas, cell)
+        el = np.concatenate((gas, solids))
         lo_el, dims = cell_counts(ye[el], cell)
         if not float(np.prod(dims.astype(float))) < MAX_CELLS:   # too spread for int64 keys
             counts, self.nbr = self._tree_pairs(ye, n)
         else:
             ca, na = cell_pairs(ye, self.gas_idx, el, self.h_ext, self.skin, cell, lo_el, dims,
                                 self.gid_ext, n)
-            lo_g, dims = cell_counts(yg, cell)
-            cb, nb = cell_pairs(ye, in_box(ye, self.solids_owned, yg, cell), gas, self.h_ext,
-                                self.skin, cell, lo_g, dims, self.gid_ext, n)
+            lo_g, dims = cell_counts(ye[gas], cell)
+            cb, nb = cell_pairs(ye, solids[solids < n], gas, self.h_ext, self.skin, cell,
+                                lo_g, dims, self.gid_ext, n)
             counts, self.nbr = merge_rows(ca, na, cb, nb)
         self.offsets[1:] = np.cumsum(counts)
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..kernels.search import in_box
+from ..kernels.search import near_cells
 
 
 class NearHalo:
@@ -57,11 +57,10 @@ class NearHalo:
         g = self.gas[self.gas_owner == q]
         if not len(cand) or not len(g):
             return np.zeros(0, np.int64)
-        yg = y[g]
-        cand = in_box(y, cand, yg, reach)
+        cand = near_cells(y, cand, g, reach)
         if not len(cand):
             return cand
-        d, _ = cKDTree(yg).query(y[cand], distance_upper_bound=reach)
+        d, _ = cKDTree(y[g]).query(y[cand], distance_upper_bound=reach)
         return cand[d < reach]
 
     def plan(self, y: np.ndarray, reach: float) -> int:
