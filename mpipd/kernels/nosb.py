@@ -352,6 +352,15 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
         gx = gy = gz = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = nbr[k]
+            kj = klass[j]
+            # the bonds that carry no force at this level are passed over before
+            # their positions are read (a broken bond without contact; a bond
+            # whose two ends' classes do not act now)
+            if broken[k]:
+                if not (contact and min(ki, kj) <= level):
+                    continue
+            elif ri == 0.0 and weight(kj, level) == 0.0:
+                continue
             e0 = x[j, 0] - xi0
             e1 = x[j, 1] - xi1
             e2 = x[j, 2] - xi2
@@ -359,20 +368,16 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
             r = 0.0                     # |xi| only where a term needs it
-            kj = klass[j]
-            if broken[k]:
-                if contact and min(ki, kj) <= level:
-                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
-                                      0.5 * (di + horizon[j])) * weight(min(ki, kj), level)
-                    vj = vol[j]
-                    fx += g * y0 * vj
-                    fy += g * y1 * vj
-                    fz += g * y2 * vj
+            if broken[k]:                # in contact, its pair acting now
+                r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+                g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
+                                  0.5 * (di + horizon[j])) * weight(min(ki, kj), level)
+                vj = vol[j]
+                fx += g * y0 * vj
+                fy += g * y1 * vj
+                fz += g * y2 * vj
                 continue
             rj = weight(kj, level)
-            if ri == 0.0 and rj == 0.0:
-                continue
             tx = ty = tz = 0.0
             w_i = wi[k] * ri
             if w_i > 0.0:
