@@ -62,3 +62,21 @@ def test_a_changed_module_gets_a_fresh_cache_and_old_ones_are_pruned(tmp_path):
     second = Path(subprocess.run(run, env=env, capture_output=True, text=True,
                                  check=True, cwd=tmp_path).stdout.strip())
     assert second != first and second.is_dir() and not first.exists()
+
+
+def test_an_editor_lock_file_or_an_unusable_root_does_not_break_the_import(tmp_path):
+    """A dangling '.#x.py' (an editor's lock) is no source; a cache root that cannot
+    be made (here: below a file) gives a warning, and numba keeps its own cache."""
+    src = _tree(tmp_path, "src")
+    key = cache.source_key([src])
+    (src / "kernels" / ".#nosb.py").symlink_to(tmp_path / "nowhere")
+    assert cache.source_key([src]) == key
+    (tmp_path / "afile").write_text("")
+    env = dict(os.environ, PYTHONPATH=str(src.parent),
+               MPIPD_KERNEL_CACHE=str(tmp_path / "afile" / "c"))
+    res = subprocess.run([sys.executable, "-W", "always", "-c",
+                          "import mpipd, numba; print(mpipd.KERNEL_CACHE, numba.config.CACHE_DIR)"],
+                         env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split()[0] == "None" and "no keyed kernel cache" in res.stderr
+    assert "afile" not in res.stdout

@@ -3,19 +3,20 @@
 numba's ``cache=True`` re-checks only the file that defines a function.  A kernel
 that calls a function of another module (and inlines it: ``classes.weight`` in
 ``nosb.gather_forces``, ``linalg`` everywhere) keeps its cached machine code after
-that other module changes — numba's documentation lists it under the cache's
-limitations ("cache invalidation fails to recognize changes in functions defined
-in a different file"; numba issue #1833).  A run of changed code could then
-compute with the old kernels and say nothing.
+that other module changes; numba documents this among its cache's limitations
+(numba issue #1833).  A run of changed code could then compute with the old
+kernels and say nothing.
 
 So :func:`configure` (called by ``import mpipd``, before any kernel is defined)
 points numba at ``<root>/<key>``, the key a hash of every ``.py`` source of mpipd
 and of ``postprocess`` beside it (names and contents): any change to any source
-starts a fresh cache, and identical sources, in any clone, share one.  The root is
-``$MPIPD_KERNEL_CACHE``, else ``$NUMBA_CACHE_DIR``, else ``$XDG_CACHE_HOME/mpipd/numba``
-(``~/.cache/mpipd/numba``).  Directories of other keys unused for ``KEEP_DAYS``
-are removed.  If the root cannot be written, numba's own locators take over (the
-cache beside the sources) and a warning says so.
+starts a fresh cache.  Clones of the same sources share the key's directory but
+not the machine code (numba names its subdirectories by each source's absolute
+path).  The root is ``$MPIPD_KERNEL_CACHE``, else ``$NUMBA_CACHE_DIR``, else
+``$XDG_CACHE_HOME/mpipd/numba`` (``~/.cache/mpipd/numba``).  Directories of other
+keys (16 hex digits) unused for ``KEEP_DAYS`` are removed; an import marks its
+key's directory used.  If the root cannot be made, numba's own locators take over
+(the cache beside the sources) and a warning says so.
 """
 from __future__ import annotations
 
@@ -30,6 +31,7 @@ from pathlib import Path
 PACKAGES = ("mpipd", "postprocess")
 #: a key's directory unused for this many days is removed
 KEEP_DAYS = 14
+HEX = set("0123456789abcdef")
 
 
 def source_key(roots) -> str:
@@ -39,6 +41,8 @@ def source_key(roots) -> str:
     for root in roots:
         root = Path(root)
         for p in sorted(root.rglob("*.py")):
+            if p.name.startswith(".") or not p.is_file():    # an editor's lock file
+                continue
             h.update(p.relative_to(root.parent).as_posix().encode())
             h.update(b"\0")
             h.update(p.read_bytes())
@@ -59,8 +63,13 @@ def _prune(root: Path, keep: str) -> None:
     """Remove the keyed directories other than ``keep`` unused for KEEP_DAYS."""
     old = time.time() - KEEP_DAYS * 86400.0
     for d in root.iterdir():
-        if d.name != keep and d.is_dir() and len(d.name) == 16 and d.stat().st_mtime < old:
-            shutil.rmtree(d, ignore_errors=True)
+        if d.name == keep or len(d.name) != 16 or any(c not in HEX for c in d.name):
+            continue
+        try:                                  # another rank may be removing it too
+            if d.is_dir() and d.stat().st_mtime < old:
+                shutil.rmtree(d, ignore_errors=True)
+        except OSError:
+            pass
 
 
 def configure() -> Path | None:
@@ -70,16 +79,19 @@ def configure() -> Path | None:
 
     here = Path(__file__).resolve().parents[1]            # the mpipd package
     roots = [here.parent / name for name in PACKAGES if (here.parent / name).is_dir()]
-    key = source_key(roots)
-    root = cache_root()
-    path = root / key
     try:
+        key = source_key(roots)
+        root = cache_root()
+        path = root / key
         path.mkdir(parents=True, exist_ok=True)
         os.utime(path)                                   # in use: not pruned
-        _prune(root, key)
-    except OSError as e:
-        warnings.warn(f"mpipd: kernel cache {path} not usable ({e}); numba caches beside "
-                      "the sources, which miss changes across modules", stacklevel=2)
+    except (OSError, RuntimeError) as e:                 # RuntimeError: no home directory
+        warnings.warn(f"mpipd: no keyed kernel cache ({e}); numba caches beside the "
+                      "sources, which miss changes across modules", stacklevel=2)
         return None
     numba.config.CACHE_DIR = str(path)
+    try:
+        _prune(root, key)
+    except OSError:
+        pass
     return path
