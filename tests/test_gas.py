@@ -329,6 +329,8 @@ def test_blast_slice_reports_peak_pressures(tmp_path):
     wall = [ln for ln in res.stdout.splitlines() if "probe wall" in ln]
     assert wall and float(wall[0].split("peak radial stress")[1].split()[0]) < -10.0
     assert "peak gas pressure" in (out / "run.log").read_text()
+    searched = [ln for ln in res.stdout.splitlines() if "gas families searched" in ln]
+    assert searched and 0 < int(searched[0].split("searched")[1].split()[0]) <= 101   # 100 steps
 
 
 #: a charge slab between two copper plates, the gas pushed along them (+z, 1 km/s) and
@@ -448,7 +450,7 @@ def _brute_pairs(y, rows, el, h, skin, gid, n):
     return fam
 
 
-@pytest.mark.parametrize("spread", [1.0, 40.0])
+@pytest.mark.parametrize("spread", [1.0, 40.0, 400.0])   # dense, dense, sparse cells
 def test_cell_list_finds_exactly_the_pairs_within_reach(spread):
     """Random points (gas with a horizon, solids with none), some rows; clustered, and
     spread over many empty cells: the cell list gives the pairs of the definition,
