@@ -353,27 +353,27 @@ class Correspondence(Model):
     def reweight(self, rows, u, v, f, fv, previous):
         """The forces of the owned ``rows`` after the step classes changed at a coarse
         boundary (every state current, force data and its ghosts unchanged): f
-        (and fv) += gather(new weights) - gather(old weights) there, so the gas's,
-        the loads' and the other points' forces stay as they are.  The interface
+        (and fv) += gather(new weights) - gather(old weights) there, in one pass over
+        the bonds whose weights changed (nosb.gather_reweight), so the gas's, the
+        loads' and the other points' forces stay as they are.  The interface
         correction's force fc is left with the new weights."""
         p, fam, cl = self.points, self.families, self.classes
-        n = p.n_owned
-        mask = np.full(n, 255, np.uint8)
-        mask[rows] = 0
-        out = []
-        for klass in (previous, cl.klass):
-            g = np.zeros((n, 3))
-            gv = np.zeros_like(fv)
-            nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
-                               fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb,
-                               self.contact, g, gv, klass, mask, cl.top)
-            if self.interface is not None:
-                self.interface.apply(self.fd, self.F, g, klass, cl.top)
-            out.append((g[rows], gv[rows] if len(gv) else gv))
-        (g0, v0), (g1, v1) = out
-        f[rows] += g1 - g0
+        g = np.empty((len(rows), 3))
+        gv = np.empty((len(rows), 3) if len(fv) else (0, 3))
+        nosb.gather_reweight(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
+                             fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact,
+                             rows, previous, cl.klass, cl.top, g, gv)
+        f[rows] += g
         if len(fv):
-            fv[rows] += v1 - v0
+            fv[rows] += gv
+        if self.interface is not None:
+            n = p.n_owned
+            out = []
+            for klass in (previous, cl.klass):
+                h = np.zeros((n, 3))
+                self.interface.apply(self.fd, self.F, h, klass, cl.top)
+                out.append(h[rows])
+            f[rows] += out[1] - out[0]
 
     def commit(self):
         """F_old <- F of the points updated at this level."""

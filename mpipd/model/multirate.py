@@ -131,7 +131,7 @@ class StepClasses:
         self._held = None
         self.previous = self.klass                     # the classes before the last change
         # this invocation's figures (the run log): bond states evaluated, steps,
-        # coarse boundaries, and those where a class changed (a second force gather)
+        # coarse boundaries, and those where a class changed (the forces' change gathered)
         self.bonds_by_class = [0.0] * (self.top + 1)
         self.evaluated = 0.0
         self.steps = self.boundaries = self.changes = 0
@@ -374,7 +374,7 @@ class StepClasses:
                         for k in range(self.top + 1))
         return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}): now {cls}; "
                 f"bond states evaluated {share:.3f} of single-rate's; classes changed at "
-                f"{self.changes} of {self.boundaries} coarse steps (a second force gather each)")
+                f"{self.changes} of {self.boundaries} coarse steps (a change of the forces gathered at each)")
 
     def counts(self, n_bonds_of: np.ndarray) -> np.ndarray:
         """(points, bonds) of this rank's owned points per class, shape (top+1, 2)."""

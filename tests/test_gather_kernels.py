@@ -1,0 +1,148 @@
+"""The correspondence gather kernels (mpipd.kernels.nosb) on hand-built lattices.
+
+* gather_forces at every level against Eq. 1 written out bond by bond in numpy
+  (the multi-rate weights of kernels.classes, no springs, contact or viscosity);
+* gather_reweight, the one-pass change of the forces when step classes change,
+  against the difference of two full gathers, with springs, contact and viscosity
+  on, and against momentum conservation (equal and opposite bond impulses).
+"""
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from mpipd.kernels import nosb
+from mpipd.kernels.layout import FD_H, FD_SPRING, FD_VISC_L, FD_VISC_Q, FD_WIDTH_VISCOUS
+
+
+def lattice(seed, n=5, dx=1.0e-3, m=3.0):
+    """A jittered n^3 lattice with CSR families within m dx, sorted by index."""
+    rng = np.random.default_rng(seed)
+    g = np.arange(n) * dx
+    x = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    x = x + rng.uniform(-0.1, 0.1, x.shape) * dx
+    delta = m * dx
+    tree = cKDTree(x)
+    rows = [sorted(j for j in tree.query_ball_point(p, delta) if j != i) for i, p in enumerate(x)]
+    offsets = np.zeros(len(x) + 1, np.int64)
+    offsets[1:] = np.cumsum([len(r) for r in rows])
+    nbr = np.concatenate(rows).astype(np.int64)
+    N = len(x)
+    vol = rng.uniform(0.8, 1.2, N) * dx ** 3
+    horizon = np.full(N, delta)
+    infl = np.zeros(N, np.int64)            # the quadratic influence function
+    wi = np.empty(len(nbr))
+    wj = np.empty(len(nbr))
+    nosb.bond_influence(x, horizon, infl, offsets, nbr, wi, wj)
+    u = rng.normal(0.0, 0.02 * dx, x.shape)
+    v = rng.normal(0.0, 1.0, x.shape)
+    fd = np.zeros((N, FD_WIDTH_VISCOUS))
+    fd[:, :9] = rng.normal(0.0, 1.0e9, (N, 9)) / delta ** 5
+    fd[:, FD_H] = rng.uniform(0.5, 1.5, N) * 1.0e9 / delta ** 5
+    cbb = np.full(N, 18 * 50e9 / (np.pi * delta ** 4))
+    return dict(x=x, u=u, v=v, vol=vol, horizon=horizon, wi=wi, wj=wj, offsets=offsets,
+                nbr=nbr, fd=fd, cbb=cbb, rng=rng)
+
+
+def gather(L, klass, level, broken=None, contact=False, fd=None):
+    N = len(L["x"])
+    fd = L["fd"] if fd is None else fd
+    broken = np.zeros(len(L["nbr"]), np.uint8) if broken is None else broken
+    kmin = np.zeros(N, np.uint8)
+    f = np.empty((N, 3))
+    fv = np.empty((N, 3) if fd.shape[1] > 11 else (0, 3))
+    nosb.gather_forces(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+                       L["offsets"], L["nbr"], broken, fd, L["cbb"], contact, f, fv,
+                       klass, kmin, level)
+    return f, fv
+
+
+@pytest.mark.parametrize("level", [0, 1, 2])
+def test_gather_is_eq1_with_the_multirate_weights(level):
+    L = lattice(1)
+    fd = L["fd"][:, :11].copy()                  # no viscosity
+    N = len(L["x"])
+    klass = L["rng"].integers(0, 3, N).astype(np.uint8)
+    f, _ = gather(L, klass, level, fd=fd)
+    # Eq. 1 bond by bond: V_j [r_i omega_i (B_i xi + h_i Y) + r_j omega_j (B_j xi + h_j Y)]
+    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
+    j = L["nbr"]
+    xi = L["x"][j] - L["x"][i]
+    Y = xi + L["u"][j] - L["u"][i]
+    r = np.where(klass <= level, 2.0 ** klass, 0.0)
+    B = fd[:, :9].reshape(N, 3, 3)
+    h = fd[:, FD_H]
+
+    def side(p, w):
+        return (r[p] * w)[:, None] * (np.einsum("bij,bj->bi", B[p], xi) + h[p][:, None] * Y)
+
+    fb = L["vol"][j][:, None] * (side(i, L["wi"]) + side(j, L["wj"]))
+    want = np.zeros((N, 3))
+    np.add.at(want, i, fb)
+    scale = np.abs(want).max()
+    assert scale > 0.0
+    assert np.abs(f - want).max() <= 1e-12 * scale
+
+
+def full_setup(seed):
+    L = lattice(seed)
+    N = len(L["x"])
+    rng = L["rng"]
+    fd = L["fd"]
+    fd[rng.random(N) < 0.15, FD_SPRING] = 1.0                   # some on the bond springs
+    on = rng.random(N) < 0.5                                      # viscosity where compressed
+    fd[on, FD_VISC_L] = rng.uniform(0.5, 1.5, on.sum()) * 1e3
+    fd[on, FD_VISC_Q] = rng.uniform(0.5, 1.5, on.sum()) * 1e3
+    # a bond breaks for both its ends: by the pair (i < j), the same draw from each side
+    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
+    j = L["nbr"]
+    draw = rng.random((N, N))
+    broken = (draw[np.minimum(i, j), np.maximum(i, j)] < 0.3).astype(np.uint8)
+    L["u"] *= 0.0
+    L["u"] += rng.normal(0.0, 0.15e-3, L["u"].shape)              # pairs close enough to touch
+    return L, broken
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_reweight_is_the_difference_of_two_gathers(seed):
+    L, broken = full_setup(seed)
+    N = len(L["x"])
+    rng = L["rng"]
+    old = rng.integers(0, 3, N).astype(np.uint8)
+    new = old.copy()
+    moved = rng.random(N) < 0.1
+    new[moved] = rng.integers(0, 3, moved.sum())
+    assert (new != old).any()
+    top = 2
+    f_old, fv_old = gather(L, old, top, broken, contact=True)
+    f_new, fv_new = gather(L, new, top, broken, contact=True)
+    for rows in (np.arange(N), np.sort(rng.choice(N, N // 3, replace=False))):
+        g = np.empty((len(rows), 3))
+        gv = np.empty((len(rows), 3))
+        nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+                             L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, rows,
+                             old, new, top, g, gv)
+        want = (f_new - f_old)[rows]
+        scale = np.abs(f_new).max()
+        assert np.abs(want).max() > 1e-6 * scale                 # the classes did change forces
+        assert np.abs(g - want).max() <= 1e-12 * scale
+        assert np.abs(gv - (fv_new - fv_old)[rows]).max() <= 1e-12 * np.abs(fv_new).max()
+    # every bond's change of impulse is equal and opposite: sum_i V_i g_i = 0
+    g = np.empty((N, 3))
+    gv = np.empty((N, 3))
+    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+                         L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
+                         old, new, top, g, gv)
+    net = (L["vol"][:, None] * g).sum(axis=0)
+    assert np.abs(net).max() <= 1e-12 * (L["vol"][:, None] * np.abs(g)).sum()
+
+
+def test_unchanged_classes_change_nothing():
+    L, broken = full_setup(4)
+    N = len(L["x"])
+    k = L["rng"].integers(0, 3, N).astype(np.uint8)
+    g = np.full((N, 3), np.nan)
+    gv = np.full((N, 3), np.nan)
+    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+                         L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
+                         k, k.copy(), 2, g, gv)
+    assert (g == 0.0).all() and (gv == 0.0).all()
