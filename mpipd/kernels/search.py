@@ -240,10 +240,11 @@ def cell_pairs(y, rows, el, h, skin, cell, lo, dims, gid, n_rows):
         for p in range(m):
             order[fill[keys[p]]] = p
             fill[keys[p]] += 1
+        skeys = keys[:0]           # the scan reads the starts, not the sorted keys
     else:
         start = np.zeros(0, np.int32)
         order = np.argsort(keys)
-    skeys = keys[order]
+        skeys = keys[order]
     counts = np.zeros(n_rows, np.int64)
     nbr, k = _scan(y, rows, el, h, skin, cell, lo, dims, order, skeys, start, gid, counts,
                    64 * rows.shape[0])
