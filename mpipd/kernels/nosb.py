@@ -27,6 +27,8 @@ omega_j of the same bond always uses point j's function and horizon.
           = sum_j [omega_i (B_i xi + h_i Y) + omega_j (B_j xi + h_j Y)] V_j,
   with the per-point force data B = A - h F, h and the fallback flag, which
   the owner of every ghost computes and the halo copies — 11 numbers a point.
+  Point i's own term is summed before its 3x3 product: sum_j omega_i (B_i xi +
+  h_i Y) V_j = B_i s_xi + h_i s_Y, s_xi = sum_j omega_i V_j xi, s_Y likewise of Y.
 * Bond-spring fallback (paper §2.1) where K (too few intact bonds) or F
   (J <= 0) cannot be inverted: that side of the bond acts as a bond-based
   spring, T = (c_bb / 2) s Y/|Y| with s = |Y|/|xi| - 1 and c_bb = 18 k / (pi delta^4).
@@ -378,6 +380,10 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
         vi_on = li != 0.0 or qi != 0.0
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
+        # i's own force state, summed over the bonds first: sum_j omega_i (B_i xi +
+        # h_i Y) V_j = B_i s_xi + h_i s_Y, with s_xi = sum_j omega_i V_j xi and s_Y the
+        # same of Y (its share of Eq. 1 without a 3x3 product per bond)
+        sx0 = sx1 = sx2 = sy0 = sy1 = sy2 = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = nbr[k]
             kj = klass[j]
@@ -418,13 +424,18 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
                 fy += g * y1 * vj
                 fz += g * y2 * vj
                 continue
+            vj = vol[j]
             tx = ty = tz = 0.0
             w_i = wi[k] * ri
             if w_i != 0.0:
                 if si == 0.0:
-                    tx = w_i * (b0 * e0 + b1 * e1 + b2 * e2 + hi * y0)
-                    ty = w_i * (b3 * e0 + b4 * e1 + b5 * e2 + hi * y1)
-                    tz = w_i * (b6 * e0 + b7 * e1 + b8 * e2 + hi * y2)
+                    a = wi[k] * vj
+                    sx0 += a * e0
+                    sx1 += a * e1
+                    sx2 += a * e2
+                    sy0 += a * y0
+                    sy1 += a * y1
+                    sy2 += a * y2
                 else:
                     r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                     g = _spring(cbb[i], r, y0, y1, y2) * ri
@@ -451,10 +462,13 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
                 gx -= cv * e0
                 gy -= cv * e1
                 gz -= cv * e2
-            vj = vol[j]
             fx += tx * vj
             fy += ty * vj
             fz += tz * vj
+        if ri != 0.0 and si == 0.0:
+            fx += ri * (b0 * sx0 + b1 * sx1 + b2 * sx2 + hi * sy0)
+            fy += ri * (b3 * sx0 + b4 * sx1 + b5 * sx2 + hi * sy1)
+            fz += ri * (b6 * sx0 + b7 * sx1 + b8 * sx2 + hi * sy2)
         f[q, 0] = fx + gx
         f[q, 1] = fy + gy
         f[q, 2] = fz + gz
