@@ -80,3 +80,18 @@ def test_an_editor_lock_file_or_an_unusable_root_does_not_break_the_import(tmp_p
     assert res.returncode == 0, res.stderr
     assert res.stdout.split()[0] == "None" and "no keyed kernel cache" in res.stderr
     assert "afile" not in res.stdout
+
+
+def test_two_processes_name_their_compiled_functions_apart():
+    """numba's symbol ids are random after ``import mpipd``: the first function each of
+    two processes compiles gets a different symbol (with counted ids both are ``v1``-like,
+    and cached libraries of two processes could bind one body for both: numba #10486)."""
+    script = ("import mpipd, numba\n"
+              "f = numba.njit(lambda x: x + 1)\n"
+              "f(1)\n"
+              "print(next(iter(f.overloads.values())).fndesc.mangled_name)\n")
+    names = [subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            check=True).stdout.strip() for _ in range(2)]
+    assert names[0] and names[1]
+    assert names[0] != names[1]
+    assert "$" not in names[0]                          # a mangled symbol, not a Python name

@@ -17,11 +17,20 @@ path).  The root is ``$MPIPD_KERNEL_CACHE``, else ``$NUMBA_CACHE_DIR``, else
 keys (16 hex digits) unused for ``KEEP_DAYS`` are removed; an import marks its
 key's directory used.  If the root cannot be made, numba's own locators take over
 (the cache beside the sources) and a warning says so.
+
+The ids numba puts in every compiled function's symbol (``v<id>``) are drawn at random
+(:func:`random_function_ids`) instead of counted from 1 in each process.  With counted
+ids, two processes give different bodies the same symbol (the same helper, say a
+``quicksort`` closure, the same id, other closure variables); a later process that
+loads both cached libraries binds one body for both and calls the wrong one.  That
+crashed ``test_gas.py`` on 2026-12-04 with a cached ``search.near_cells`` compiled as
+its process's first function (numba issue #10486, where this remedy is proposed).
 """
 from __future__ import annotations
 
 import hashlib
 import os
+import secrets
 import shutil
 import time
 import warnings
@@ -72,11 +81,30 @@ def _prune(root: Path, keep: str) -> None:
             pass
 
 
+class _RandomIds:
+    """An endless iterator of random 63-bit integers (numba draws function ids with next())."""
+
+    def __iter__(self):
+        return self
+
+    def __next__(self) -> int:
+        return secrets.randbits(63)
+
+
+def random_function_ids() -> None:
+    """Make numba's function ids random in this process (module docstring)."""
+    from numba.core import bytecode
+
+    if not isinstance(bytecode.FunctionIdentity._unique_ids, _RandomIds):
+        bytecode.FunctionIdentity._unique_ids = _RandomIds()
+
+
 def configure() -> Path | None:
     """Point numba's cache at ``cache_root()/source_key(...)``; returns that directory
     (None, with a warning, if it cannot be made)."""
     import numba
 
+    random_function_ids()
     here = Path(__file__).resolve().parents[1]            # the mpipd package
     roots = [here.parent / name for name in PACKAGES if (here.parent / name).is_dir()]
     try:
