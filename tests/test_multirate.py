@@ -23,13 +23,13 @@ def _team():
     return Team(MPI.COMM_SELF)
 
 
-def bar(dt, t_end, ratio=None, coarse=None, x_split=0.04, extra=()):
+def bar(dt, t_end, ratio=None, coarse=None, x_split=0.04, extra=(), buffer="full"):
     """The elastic bar (``extra``: more overrides); with ``ratio``, class 0 for
     x < x_split and ``coarse`` beyond (all points ``coarse`` if x_split is None),
-    held there at every boundary."""
+    held there at every boundary (their base classes: ``buffer`` spreads them)."""
     over = BAR + list(extra) + [f"time.dt={dt}", f"time.t_end={t_end}"]
     if ratio:
-        over.append(f"time.multirate={{max_ratio={ratio}, safety=1.0}}")
+        over.append(f'time.multirate={{max_ratio={ratio}, safety=1.0, buffer="{buffer}"}}')
     scene, _ = sc.load("elastic_wave", over)
     sim = Simulation(scene, _team())
     if ratio:
@@ -84,6 +84,8 @@ def test_level_schedule():
     ("time.multirate={ratio=4}", "time.multirate.ratio", "unknown key"),
     ("time.multirate={max_ratio=8}", "time.steps", "max_ratio = 8"),     # 300 steps
     ("time.multirate={max_ratio=4}", "output.every", "max_ratio = 4"),     # every = 5
+    ('time.multirate={buffer="wide"}', "time.multirate.buffer", '"graded"'),
+    ("time.multirate={max_ratio=4, fracture_class=3}", "time.multirate.fracture_class", "0..2"),
 ])
 def test_bad_multirate_is_refused_naming_the_key(override, key, word):
     with pytest.raises(SceneError) as err:
@@ -103,15 +105,16 @@ def test_one_class_is_the_single_rate_run_at_the_coarse_step():
     assert np.abs(a.v[:n] - b.v[:n]).max() <= 1e-9 * np.abs(b.v[:n]).max()
 
 
-@pytest.mark.parametrize("ratio", [2, 4, 8])
-def test_plane_wave_crosses_a_class_boundary(ratio):
+@pytest.mark.parametrize("ratio,buffer", [(2, "full"), (4, "full"), (8, "full"), (4, "graded"),
+                                          (8, "graded")])
+def test_plane_wave_crosses_a_class_boundary(ratio, buffer):
     """A P pulse runs from the fine half (class 0) into the coarse half (class
-    log2 ratio) of the bar.  Against the single-rate run at the fine dt:
-    momentum is exact at every coarse step, the fields differ by a small
-    fraction, no energy is reflected at the boundary beyond the single-rate
-    run's own tail, and the pulse moves at c_P."""
+    log2 ratio) of the bar (with the graded buffer a layer of each class between).
+    Against the single-rate run at the fine dt: momentum is exact at every coarse
+    step, the fields differ by a small fraction, no energy is reflected at the
+    boundary beyond the single-rate run's own tail, and the pulse moves at c_P."""
     dt, t_end = 2.5e-8, 1.4e-5          # the pulse has left the boundary (x = 40 mm)
-    scene, mr = bar(dt, t_end, ratio=ratio, coarse=ratio.bit_length() - 1)
+    scene, mr = bar(dt, t_end, ratio=ratio, coarse=ratio.bit_length() - 1, buffer=buffer)
     _, sr = bar(dt, t_end)
     dp, bal = advance(scene, mr)
     advance(scene, sr)
@@ -136,11 +139,12 @@ def test_plane_wave_crosses_a_class_boundary(ratio):
     assert bal < 5e-3
 
 
-def test_class_boundary_stays_stable_over_many_crossings():
+@pytest.mark.parametrize("buffer", ["full", "graded"])
+def test_class_boundary_stays_stable_over_many_crossings(buffer):
     """Ratio 8 at its stability limit: the pulse crosses the class boundary four
     times (reflections at both free ends) and the energy stays bounded."""
     dt = 1.6e-8                 # 8 dt = 1.28e-7 s, just under the bar's critical step
-    scene, sim = bar(dt, 3.84e-5, ratio=8, coarse=3)
+    scene, sim = bar(dt, 3.84e-5, ratio=8, coarse=3, buffer=buffer)
     e0 = sim.energies().held
     _, bal = advance(scene, sim, every=80)
     assert bal < 1e-2
@@ -157,14 +161,37 @@ def test_too_coarse_a_class_is_detected():
                 sim.check_finite()
 
 
-def test_state_following_classes_and_the_ledger():
+def test_the_buffer_spreads_each_base_class_over_the_family():
+    """k_i = min over i's family of base_j ("full") or of min(base_i, base_j + 1)
+    ("graded"), written out bond by bond over the bar's CSR families; the graded
+    buffer leaves a layer of class 1 between classes 0 and 2."""
+    got = {}
+    for buffer in ("full", "graded"):
+        _, sim = bar(2.5e-8, 1e-6, ratio=4, coarse=2, buffer=buffer)
+        cl, fam = sim.classes, sim.families
+        n = sim.points.n_owned
+        base = cl.kbase.astype(int)
+        want = np.empty(n, int)
+        for i in range(n):
+            js = fam.nbr[fam.offsets[i]:fam.offsets[i + 1]]
+            lift = 0 if buffer == "full" else 1
+            want[i] = min([base[i]] + [min(base[j] + lift, 2) for j in js])
+        np.testing.assert_array_equal(cl.klass[:n], want)
+        got[buffer] = np.bincount(cl.klass[:n], minlength=3)
+    assert got["full"][1] == 0 and got["graded"][1] > 0
+    assert got["graded"][0] < got["full"][0]          # the layer came out of class 0
+
+
+@pytest.mark.parametrize("buffer", ["full", "graded"])
+def test_state_following_classes_and_the_ledger(buffer):
     """granite_ring (JH2, tension failure, contact, viscosity, damping) with classes
     from the state: the crushed zone takes the fine class, classes change at
     boundaries (booked in the ledger's multirate term) and the ledger closes
     (refresh_after_break on, as in test_ledger's bound for this impact: without
     it the pre-break force of every breakage is a first-order error of its own)."""
     over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
-            "time.multirate={max_ratio=4, safety=0.9}", "solver.refresh_after_break=true"]
+            f'time.multirate={{max_ratio=4, safety=0.9, buffer="{buffer}"}}',
+            "solver.refresh_after_break=true"]
     scene, _ = sc.load("granite_ring", over)
     sim = Simulation(scene, _team())
     n = sim.points.n_owned

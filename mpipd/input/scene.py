@@ -80,9 +80,15 @@ class Multirate:
     """Multi-rate integration (mpipd.model.multirate): every point takes steps of
     2^k dt, k from its material's stable step at its current state times
     ``safety``, up to ``max_ratio`` dt (the coarse step: failure, breakage,
-    frames and checkpoints happen every ``max_ratio`` steps)."""
+    frames and checkpoints happen every ``max_ratio`` steps).  ``buffer``: how a
+    point's class follows its family's, "full" (no coarser than any point it pushes)
+    or "graded" (at most one class coarser: a step ratio of 2 across any bond);
+    ``fracture_class``: the class a point whose family lost bonds in the last coarse
+    steps takes at most (docs/multirate.md, The class rule)."""
     max_ratio: int = 4
     safety: float = 0.5
+    buffer: str = "graded"
+    fracture_class: int = 0
 
     def check(self, path):
         if self.max_ratio not in MAX_RATIOS:
@@ -91,10 +97,19 @@ class Multirate:
                  f"the ratios the verification covers); got {self.max_ratio}")
         if not 0.0 < self.safety <= 1.0:
             fail(join(path, "safety"), f"safety must be in (0, 1] (got {self.safety})")
+        if self.buffer not in BUFFERS:
+            fail(join(path, "buffer"), "buffer must be one of "
+                 + ", ".join(f'"{b}"' for b in BUFFERS) + f" (got {self.buffer!r})")
+        top = self.max_ratio.bit_length() - 1
+        if not 0 <= self.fracture_class <= top:
+            fail(join(path, "fracture_class"), f"fracture_class must be a class 0..{top} of "
+                 f"max_ratio = {self.max_ratio} (got {self.fracture_class})")
 
 
 #: the coarse/fine step ratios multi-rate integration accepts (verified in make verify)
 MAX_RATIOS = (1, 2, 4, 8)
+#: how a point's class follows its family's (mpipd.model.multirate.StepClasses._spread)
+BUFFERS = ("full", "graded")
 
 
 @dataclass(frozen=True)

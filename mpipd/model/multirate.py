@@ -38,7 +38,8 @@ function of each point's own state, then of its family by halo exchange):
                                                           reference P-wave speed)
     r_i  = safety * dt_i / dt
     base = floor(log2 r_i), clipped to 0..log2(max_ratio), 0 for the gas
-    k_i  = min over i's family (bonds broken or not) of base_j    (the buffer)
+    k_i  = min over i's family (bonds broken or not) of base_j    (the buffer, "full")
+    k_i  = min(base_i, min over i's family of base_j + 1)        (the buffer, "graded")
 
 c_i(state) is the material's P-wave speed at the larger of its compression now
 and the compression extrapolated over two coarse steps at its current rate
@@ -66,11 +67,16 @@ worst such point; the scene's remedy is a smaller dt with a larger max_ratio
 than half the point's own margin at rest (``coarsening_margin``): a point whose
 ratio at rest lies less than HYSTERESIS above its class's threshold (the 0.8 mm
 granite of blast_paper: 4.35 against 4) would otherwise never return to it once
-refined.  Refining is immediate.  The buffer makes every element's class no coarser than any point
-it pushes.  When a class changes, the forces at the boundary are gathered
-again with the new weights (the second half kick of velocity Verlet with a
-changed step), and the jump of the integrator term this makes is booked in
-the ledger's ``multirate`` entry.
+refined.  Refining is immediate.  The full buffer makes every element's class no
+coarser than any point it pushes; the graded one (the default) lets it be one class
+coarser, a step ratio of 2 across a bond, the 2:1 grading of subcycled and adaptive
+meshes: each element still steps within its own stable estimate, the condition of the
+AVI stability analysis (Fong et al. 2008), while the layer beside every fine point no
+longer steps at the finest class (docs/multirate.md).  A point whose family lost bonds
+in the last RECENT coarse steps takes at most ``fracture_class``.  When a class
+changes, the forces at the boundary are gathered again with the new weights (the
+second half kick of velocity Verlet with a changed step), and the jump of the
+integrator term this makes is booked in the ledger's ``multirate`` entry.
 """
 from __future__ import annotations
 
@@ -115,6 +121,10 @@ class StepClasses:
         mr = scene.time.multirate
         self.ratio = mr.max_ratio if mr is not None else 1
         self.safety = mr.safety if mr is not None else 1.0
+        #: the buffer: a class no coarser than any pushed point's ("full") or at most one
+        #: class coarser ("graded"); the class a fracturing family takes at most
+        self.graded = mr is not None and mr.buffer == "graded"
+        self.fracture_class = mr.fracture_class if mr is not None else 0
         self.top = self.ratio.bit_length() - 1
         self.dt = scene.time.dt
         n, nl = points.n_owned, points.n_local
@@ -277,8 +287,9 @@ class StepClasses:
         up = np.clip(up, 0, self.top).astype(np.uint8)
         k = np.minimum(down, np.maximum(self.kbase[:n], up))
         # fracturing: a family that changed (bonds broke) within the last RECENT coarse
-        # steps takes the finest class
-        k[step - self.touched <= RECENT * self.ratio] = 0
+        # steps takes at most the fracture class (the finest by default)
+        recent = step - self.touched <= RECENT * self.ratio
+        k[recent] = np.minimum(k[recent], self.fracture_class)
         return k
 
     def _count_over(self, ratio, material, gid, step: int):
@@ -338,10 +349,17 @@ class StepClasses:
         return np.flatnonzero(out == 0)
 
     def _spread(self, halo):
-        """The buffer and the receivers' levels, from the owned base classes."""
+        """The buffer and the receivers' levels, from the owned base classes:
+        k_i = min over i's family of base_j ("full"), or of min(base_i, base_j + 1)
+        ("graded")."""
         n, fam = self.n_owned, self.families
         halo.exchange(self.kbase)
-        family_min(fam.offsets, fam.nbr, self.kbase, self.klass[:n])
+        if self.graded:
+            up = np.minimum(self.kbase.astype(np.int16) + 1, self.top).astype(np.uint8)
+            family_min(fam.offsets, fam.nbr, up, self.klass[:n])
+            np.minimum(self.klass[:n], self.kbase[:n], out=self.klass[:n])
+        else:
+            family_min(fam.offsets, fam.nbr, self.kbase, self.klass[:n])
         halo.exchange(self.klass)
         family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
         self._recount()
