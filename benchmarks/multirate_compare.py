@@ -49,12 +49,24 @@ def read(run_dir: Path) -> dict:
                "modes": [int(m) for m in f.attrs["failed_points_by_mode"]],
                "broken": int(f.attrs["bonds_broken"]),
                "balance": float(f["energy/balance"][-1]),
-               "multirate": float(f["energy/multirate"][-1]) if "energy/multirate" in f else 0.0}
+               "multirate": float(f["energy/multirate"][-1]) if "energy/multirate" in f else 0.0,
+               "evaluated": evaluated(seg)}
     rep = run_dir / "report" / "report.json"
     j = json.loads(rep.read_text()) if rep.exists() else {}
     out["targets"] = [(t["label"], t.get("unit", ""), t.get("value"))
                       for t in j.get("targets", [])] + lattice_rows(j)
     return out
+
+
+def evaluated(segments) -> float | None:
+    """The share of single-rate's bond states the run evaluated: each segment's
+    ``bond_states_evaluated`` weighted by its steps (None if a segment lacks it: runs
+    made before the segments kept it)."""
+    got = [(s["to_step"] - s["from_step"], s.get("bond_states_evaluated")) for s in segments]
+    if not got or any(v is None for _, v in got):
+        return None
+    steps = sum(n for n, _ in got)
+    return round(sum(n * v for n, v in got) / max(steps, 1), 4)
 
 
 def lattice_rows(report: dict) -> list[tuple[str, str, object]]:
@@ -86,6 +98,7 @@ def read_report(path: Path) -> dict:
             "modes": modes, "broken": int(run["bonds_broken"]),
             "balance": float(j["energy_ledger"]["balance"][-1]),
             "multirate": float(j["energy_ledger"]["final_J"].get("multirate", 0.0)),
+            "evaluated": evaluated(run.get("segments", [])),
             "targets": [(t["label"], t.get("unit", ""), t.get("value")) for t in j["targets"]]
             + lattice_rows(j)}
 
@@ -117,6 +130,7 @@ def table(runs: dict) -> str:
     row("ranks", lambda r: r["ranks"], False)
     row("dt (s)", lambda r: r["dt"], False)
     row("loop wall time (s)", lambda r: round(r["wall"], 1))
+    row("bond states evaluated (of single-rate's)", lambda r: r["evaluated"])
     row("failed: JH2 plastic", lambda r: r["modes"][1])
     row("failed: JH2 tensile", lambda r: r["modes"][2])
     row("failed: tension model", lambda r: r["modes"][3])
@@ -131,7 +145,8 @@ def table(runs: dict) -> str:
 
 def quantities(r) -> list[tuple[str, object]]:
     """(name, value) of the numbers the band table compares."""
-    out = [("failed: JH2 plastic", r["modes"][1]), ("failed: tension model", r["modes"][3]),
+    out = [("bond states evaluated (of single-rate's)", r["evaluated"]),
+           ("failed: JH2 plastic", r["modes"][1]), ("failed: tension model", r["modes"][3]),
            ("bonds broken", r["broken"]), ("ledger balance at the end", r["balance"])]
     out += [(f"{label} ({unit})" if unit else label, v) for label, unit, v in r["targets"]]
     return out

@@ -22,23 +22,27 @@ CASES_SCENE ?= blast_demo
 cases: install
 	$(PY) benchmarks/cases.py --scene $(CASES_SCENE) --out runs/cases --mpirun $(MPIRUN)
 
-# multi-rate against single-rate on blast_demo (docs/multirate.md): single-rate and
-# ratio 4 each at five time steps dt = 2 us / N (N = MR_N; 100 is the scene's dt, 200
-# is dt/2), ratio 2 at the scene's dt, each reported, then the table
+# multi-rate against single-rate on blast_demo (docs/multirate.md): single-rate, ratio 4
+# (the graded buffer, the default), ratio 4 with the full buffer and ratio 4 with
+# fracture_class = 1, each at five time steps dt = 2 us / N (N = MR_N; 100 is the scene's
+# dt, 200 is dt/2), ratio 2 at the scene's dt, each reported, then the table
 # docs/multirate_blast_demo.md with each group's range over dt (about 25 minutes on 2 cores)
 MR_N := 100 96 104 120 200
-MR_RUNS := $(foreach n,$(MR_N),sr_$(n)) $(foreach n,$(MR_N),mr4_$(n)) mr2_100
+MR_RUNS := $(foreach g,sr mr4 mr4full mr4fc1,$(foreach n,$(MR_N),$(g)_$(n))) mr2_100
+MR_SET_sr :=
+MR_SET_mr4 := --set "time.multirate={max_ratio=4, safety=0.5}"
+MR_SET_mr4full := --set 'time.multirate={max_ratio=4, safety=0.5, buffer="full"}'
+MR_SET_mr4fc1 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_class=1}"
 .PHONY: multirate-verify
 verify: multirate-verify
 multirate-verify: install
 	for n in $(MR_N); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
-	  $(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/multirate/sr_$$n --overwrite --quiet \
-	    --set time.dt=$$dt --set output.every=$$n || exit 1; \
-	  $(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo:multirate --out runs/multirate/mr4_$$n --overwrite \
-	    --quiet --set time.dt=$$dt --set output.every=$$n || exit 1; done
+	  $(foreach g,sr mr4 mr4full mr4fc1,$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo \
+	    --out runs/multirate/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$n \
+	    $(MR_SET_$(g)) || exit 1;) done
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/multirate/mr2_100 --overwrite --quiet --set "time.multirate={max_ratio=2, safety=0.5}"
 	for r in $(MR_RUNS); do $(MPIRUN) -n 2 $(PY) -m postprocess report runs/multirate/$$r/run.h5 --out runs/multirate/$$r/report > /dev/null || exit 1; done
-	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4 \
+	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4,mr4full,mr4fc1 --stats \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
 
 # the rock mass on blast_demo (README: The rock mass): the lattice, jitter, Weibull

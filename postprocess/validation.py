@@ -219,6 +219,8 @@ def provenance(runs) -> list[str]:
                                           r["doc"]["run"].get("steps"))),
         ("throughput", lambda r: _throughput(r["doc"]["run"].get("segments"),
                                              r["doc"]["run"].get("steps"))),
+        ("bond states evaluated (of single-rate's)",
+         lambda r: _evaluated(r["doc"]["run"].get("segments"))),
         ("impossible values (errors)", lambda r: str(len(r["doc"].get("errors", [])))),
     ]
     L = ["## Provenance", "",
@@ -231,7 +233,10 @@ def provenance(runs) -> list[str]:
           "ranks and commit of each), summed; throughput = TL bonds x steps / that time.  "
           "Runs made before the run file kept its segments show 'not recorded'.  An "
           "invocation killed before it could write (no clean stop) leaves no segment: "
-          "the steps no segment covers are named, and the time is then a lower bound."]
+          "the steps no segment covers are named, and the time is then a lower bound.  "
+          "Bond states evaluated: the share of single-rate's bond states a multi-rate run "
+          "evaluated (each segment's `bond_states_evaluated`, weighted by its steps; 1 "
+          "single-rate); segments written before 2026-12-05 lack it."]
     return L + [""]
 
 
@@ -263,6 +268,16 @@ def _wall(segments, steps=None) -> str:
     gaps = _gaps_text(segments, steps)
     return (f"{'at least ' if gaps else ''}{wall / 60:.1f} min ({len(segments)} invocation(s) on "
             f"{'/'.join(map(str, ranks))} rank(s){gaps})")
+
+
+def _evaluated(segments) -> str:
+    """The share of single-rate's bond states over a run's invocations, each weighted
+    by its steps."""
+    if not segments or any(s.get("bond_states_evaluated") is None for s in segments):
+        return NOT_RECORDED
+    n = [s["to_step"] - s["from_step"] for s in segments]
+    share = sum(k * s["bond_states_evaluated"] for k, s in zip(n, segments)) / max(sum(n), 1)
+    return f"{share:.3f}"
 
 
 def _throughput(segments, steps=None) -> str:

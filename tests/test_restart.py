@@ -3,6 +3,7 @@ different number of ranks, and get the uninterrupted run's fields bit for bit.
 The stop (step 230) falls in a step where bonds break, so the checkpoint must
 carry the previous F (from the shape tensors before that breakage)."""
 import json
+import re
 import shutil
 
 import h5py
@@ -57,6 +58,7 @@ def test_restart_same_and_different_rank_count(tmp_path, reference):
             assert [(s["from_step"], s["to_step"], s["ranks"]) for s in segs] == \
                 [(0, 230, 2), (230, int(f.attrs["steps"]), n)]
             assert all(s["wall_s"] > 0 and s["bond_steps_per_s"] > 0 for s in segs)
+            assert all(s["bond_states_evaluated"] == 1.0 for s in segs)     # single-rate
             for k in KEYS:
                 assert np.array_equal(f[k][...], reference[k]), f"{k} differs after restart on {n}"
 
@@ -70,6 +72,7 @@ def test_multirate_restart_on_another_rank_count(tmp_path):
     ref = tmp_path / "ref"
     res = run_cli(["run", "granite_ring", "--out", str(ref), *ARGS, *MR], ranks=1)
     assert res.returncode == 0, res.stderr
+    logged = float(re.search(r"bond states evaluated ([0-9.]+) of single-rate", res.stdout)[1])
     a = tmp_path / "a"
     res = run_cli(["run", "granite_ring", "--out", str(a), "--stop-after", "232", *ARGS, *MR],
                   ranks=2)
@@ -79,6 +82,11 @@ def test_multirate_restart_on_another_rank_count(tmp_path):
     assert res.returncode == 0, res.stdout + res.stderr
     with h5py.File(ref / "run.h5", "r") as f0, h5py.File(a / "run.h5", "r") as f1:
         assert f1.attrs["bonds_broken"] == f0.attrs["bonds_broken"]
+        # the share of single-rate's bond states each invocation evaluated, in its record
+        (seg,) = json.loads(f0.attrs["segments"])
+        assert 0.0 < seg["bond_states_evaluated"] < 1.0
+        assert seg["bond_states_evaluated"] == pytest.approx(logged, abs=6e-4)
+        assert all(0.0 < s["bond_states_evaluated"] < 1.0 for s in json.loads(f1.attrs["segments"]))
         for k in KEYS:
             assert np.array_equal(f1[k][...], f0[k][...]), f"{k} differs after restart"
 

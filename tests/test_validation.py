@@ -72,9 +72,11 @@ def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces"
     if case == "alpha":         # a run stopped at step 200 on 2 ranks, restarted on 3
         doc["run"]["segments"] = [
             {"from_step": 0, "to_step": 200, "ranks": 2, "wall_s": 60.0,
-             "bond_steps_per_s": 999 * 200 / 60.0, "git_commit": "0123"},
+             "bond_steps_per_s": 999 * 200 / 60.0, "git_commit": "0123",
+             "bond_states_evaluated": 0.5},
             {"from_step": 200, "to_step": 600, "ranks": 3, "wall_s": 180.0,
-             "bond_steps_per_s": 999 * 400 / 180.0, "git_commit": "0123"}]
+             "bond_steps_per_s": 999 * 400 / 180.0, "git_commit": "0123",
+             "bond_states_evaluated": 0.2}]
     return doc
 
 
@@ -159,6 +161,8 @@ def test_record(two_reports, capsys):
                                      "not recorded"]
     assert prov["throughput"] == [f"{999 * 600 / 240 / 1e6:.2f} M bond-steps/s "
                                   f"({per_rank / 1e6:.2f} M per rank)", "not recorded"]
+    # 200 steps at 0.5 and 400 at 0.2 of single-rate's bond states: (100 + 80) / 600
+    assert prov["bond states evaluated (of single-rate's)"] == ["0.300", "not recorded"]
 
     ts = table(md, "## Wave speed against the arrival threshold")
     assert ts[0] == ["run", "probes", "2 %", "10 %", "50 %"]

@@ -385,14 +385,22 @@ class StepClasses:
         """One line for the run log: the classes now, the share of the single-rate
         bond work this invocation evaluated, and how often the classes changed."""
         per = team.sum(self.counts(self.fam_bonds))
-        ev = team.sum(np.array([self.evaluated, float(self.steps)]))
-        total = float(per[:, 1].sum())
-        share = ev[0] / max(ev[1] / team.size * total, 1.0)
+        share = self.evaluated_share(team)
         cls = ", ".join(f"class {k} (dt x {2 ** k}) {per[k, 0]} points / {per[k, 1]} bonds"
                         for k in range(self.top + 1))
-        return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}): now {cls}; "
+        buffer = "graded" if self.graded else "full"
+        return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}, {buffer} buffer, "
+                f"fracture class {self.fracture_class}): now {cls}; "
                 f"bond states evaluated {share:.3f} of single-rate's; classes changed at "
                 f"{self.changes} of {self.boundaries} coarse steps (a change of the forces gathered at each)")
+
+    def evaluated_share(self, team) -> float:
+        """The bond states this invocation evaluated over those single-rate steps
+        would have (collective): sum over steps of the bonds of the acting classes,
+        over steps x all bonds."""
+        ev = team.sum(np.array([self.evaluated, float(self.steps)]))
+        total = team.sum(np.array([float(self.fam_bonds.sum())]))[0]
+        return float(ev[0] / max(ev[1] / team.size * total, 1.0))
 
     def counts(self, n_bonds_of: np.ndarray) -> np.ndarray:
         """(points, bonds) of this rank's owned points per class, shape (top+1, 2)."""

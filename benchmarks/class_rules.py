@@ -1,0 +1,138 @@
+"""What each part of the multi-rate class rule costs at a checkpoint: the points and
+bonds per class, and the bond states a fine step evaluates against single-rate
+(``projected_cost``), under the rule as the scene states it and with one part of the
+rule changed at a time (docs/multirate.md, The class rule).
+
+    python benchmarks/class_rules.py CHECKPOINT [KEY=VALUE ...] [--out FILE]
+
+Runs on one rank: it restores the checkpoint, takes ``max_ratio`` steps to the next
+coarse boundary (so the state the rule reads is current), then recomputes every owned
+point's base class from that state with ``StepClasses.base_classes``'s formula and
+spreads it with each buffer.  Nothing of the run is written.  The variants:
+
+* the rule (the scene's buffer) and the other buffer;
+* no buffer (every point at its own base class);
+* without the fracture rule (a family that lost bonds in the last coarse steps);
+* the fracture rule at class 1 instead of 0;
+* without the family factor kappa.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def restore(path, overrides):
+    from mpi4py import MPI
+
+    from mpipd.input import scene as sc
+    from mpipd.output import checkpoint as ck
+    from mpipd.parallel.team import Team
+    from mpipd.solver import Simulation
+    info = ck.read_scene(path)
+    scene = sc.parse(info.scene, str(path), info.overrides + list(overrides))
+    sim = Simulation(scene, Team(MPI.COMM_SELF))
+    ck.restore(sim, path)
+    for _ in range(sim.classes.ratio):
+        sim.step()
+    return sim
+
+
+def base_classes(sim, kappa=True, fracture_class=None):
+    """StepClasses.base_classes with the family factor on or off and the fracture
+    rule's class changed (None: left out)."""
+    from mpipd.kernels.classes import min_stretch
+    from mpipd.model.multirate import RECENT
+    C, corr = sim.classes, sim.corr
+    n = C.n_owned
+    kap = C.family_factor(corr) if kappa else np.ones(n)
+    r = np.zeros(n)
+    for g in corr.groups:
+        idx = g.idx
+        mu = 1.0 / corr.J_end[idx] - 1.0
+        d = corr.d[idx]
+        rate = -(d[:, 0] + d[:, 1] + d[:, 2]) * (1.0 + mu)
+        mu_ahead = mu + np.maximum(rate, 0.0) * 2.0 * C.ratio * C.dt
+        c = np.maximum(g.material.p_wave_speed_at(mu), g.material.p_wave_speed_at(mu_ahead))
+        lam = np.empty(len(idx))
+        min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
+        r[idx] = C.safety * C.dtc[idx] * lam * kap[idx] * C.cp0[idx] / c / C.dt
+    with np.errstate(divide="ignore"):
+        down = np.floor(np.log2(np.maximum(r, 1e-300)))
+        up = np.floor(np.log2(np.maximum(r / C.hyst, 1e-300)))
+    down = np.clip(down, 0, C.top).astype(np.uint8)
+    up = np.clip(up, 0, C.top).astype(np.uint8)
+    k = np.minimum(down, np.maximum(C.kbase[:n], up))
+    if fracture_class is not None:
+        recent = C.step - C.touched <= RECENT * C.ratio
+        k[recent] = np.minimum(k[recent], fracture_class)
+    return k
+
+
+def spread(sim, kb, buffer):
+    """The classes after the buffer ("full", "graded" or None) on one rank."""
+    from mpipd.kernels.classes import family_min
+    C, fam = sim.classes, sim.families
+    n = C.n_owned
+    if buffer is None:
+        return kb
+    a = np.full(sim.points.n_local, C.top, np.uint8)
+    a[:n] = kb if buffer == "full" else np.minimum(kb.astype(np.int16) + 1, C.top)
+    out = np.empty(n, np.uint8)
+    family_min(fam.offsets, fam.nbr, a, out)
+    return out if buffer == "full" else np.minimum(out, kb)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("checkpoint")
+    ap.add_argument("set", nargs="*", metavar="KEY=VALUE", help="scene overrides")
+    ap.add_argument("--out", help="also write the table (markdown) here")
+    args = ap.parse_args(argv)
+
+    from mpipd.model.multirate import projected_cost
+    sim = restore(args.checkpoint, args.set)
+    C = sim.classes
+    if not C.enabled:
+        print("the scene is single-rate: no classes", file=sys.stderr)
+        return 2
+    n = C.n_owned
+    bonds = C.fam_bonds
+    mr = sim.scene.time.multirate
+    other = "full" if mr.buffer == "graded" else "graded"
+    fc = mr.fracture_class
+    rows = [
+        (f"the rule (buffer {mr.buffer}, fracture class {fc})", base_classes(sim, fracture_class=fc), mr.buffer),
+        (f"buffer {other}", base_classes(sim, fracture_class=fc), other),
+        ("no buffer", base_classes(sim, fracture_class=fc), None),
+        ("no fracture rule", base_classes(sim), mr.buffer),
+        (f"fracture class {1 if fc == 0 else 0}", base_classes(sim, fracture_class=1 if fc == 0 else 0),
+         mr.buffer),
+        ("no family factor kappa", base_classes(sim, kappa=False, fracture_class=fc), mr.buffer),
+    ]
+    failed = int(np.count_nonzero(sim.mode[:n]))
+    lines = [f"Classes at {args.checkpoint} (step {C.step}, {sim.t * 1e6:.2f} us): {n} points, "
+             f"{failed} failed, {int(bonds.sum())} bonds; max_ratio {C.ratio}, safety {C.safety}.",
+             "", "| rule | points per class | bonds per class (M) | bond states evaluated |",
+             "|---|---|---|---|"]
+    for name, kb, buffer in rows:
+        k = spread(sim, kb, buffer)
+        pts = np.bincount(k, minlength=C.top + 1)
+        per = np.bincount(k, weights=bonds, minlength=C.top + 1)
+        lines.append(f"| {name} | {' / '.join(str(int(x)) for x in pts)} | "
+                     f"{' / '.join(f'{x / 1e6:.2f}' for x in per)} | {projected_cost(per):.3f} |")
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.out:
+        Path(args.out).write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
