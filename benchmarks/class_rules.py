@@ -44,35 +44,12 @@ def restore(path, overrides):
     return sim
 
 
-def base_classes(sim, kappa=True, fracture_class=None):
-    """StepClasses.base_classes with the family factor on or off and the fracture
-    rule's class changed (None: left out)."""
-    from mpipd.kernels.classes import min_stretch
-    from mpipd.model.multirate import RECENT
-    C, corr = sim.classes, sim.corr
-    n = C.n_owned
-    kap = C.family_factor(corr) if kappa else np.ones(n)
-    r = np.zeros(n)
-    for g in corr.groups:
-        idx = g.idx
-        mu = 1.0 / corr.J_end[idx] - 1.0
-        d = corr.d[idx]
-        rate = -(d[:, 0] + d[:, 1] + d[:, 2]) * (1.0 + mu)
-        mu_ahead = mu + np.maximum(rate, 0.0) * 2.0 * C.ratio * C.dt
-        c = np.maximum(g.material.p_wave_speed_at(mu), g.material.p_wave_speed_at(mu_ahead))
-        lam = np.empty(len(idx))
-        min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
-        r[idx] = C.safety * C.dtc[idx] * lam * kap[idx] * C.cp0[idx] / c / C.dt
-    with np.errstate(divide="ignore"):
-        down = np.floor(np.log2(np.maximum(r, 1e-300)))
-        up = np.floor(np.log2(np.maximum(r / C.hyst, 1e-300)))
-    down = np.clip(down, 0, C.top).astype(np.uint8)
-    up = np.clip(up, 0, C.top).astype(np.uint8)
-    k = np.minimum(down, np.maximum(C.kbase[:n], up))
-    if fracture_class is not None:
-        recent = C.step - C.touched <= RECENT * C.ratio
-        k[recent] = np.minimum(k[recent], fracture_class)
-    return k
+def base_classes(sim, kappa=True, fracture=True, fracture_class=None):
+    """StepClasses.base_classes at the current state, with the family factor on or off
+    and the fracture rule on (at ``fracture_class``, None: the scene's) or off."""
+    C = sim.classes
+    return C.base_classes(sim.corr, C.step, kappa=kappa, fracture=fracture,
+                          fracture_class=fracture_class)
 
 
 def spread(sim, kb, buffer):
@@ -107,14 +84,15 @@ def main(argv=None) -> int:
     mr = sim.scene.time.multirate
     other = "full" if mr.buffer == "graded" else "graded"
     fc = mr.fracture_class
+    rule = base_classes(sim)
     rows = [
-        (f"the rule (buffer {mr.buffer}, fracture class {fc})", base_classes(sim, fracture_class=fc), mr.buffer),
-        (f"buffer {other}", base_classes(sim, fracture_class=fc), other),
-        ("no buffer", base_classes(sim, fracture_class=fc), None),
-        ("no fracture rule", base_classes(sim), mr.buffer),
+        (f"the rule (buffer {mr.buffer}, fracture class {fc})", rule, mr.buffer),
+        (f"buffer {other}", rule, other),
+        ("no buffer", rule, None),
+        ("no fracture rule", base_classes(sim, fracture=False), mr.buffer),
         (f"fracture class {1 if fc == 0 else 0}", base_classes(sim, fracture_class=1 if fc == 0 else 0),
          mr.buffer),
-        ("no family factor kappa", base_classes(sim, kappa=False, fracture_class=fc), mr.buffer),
+        ("no family factor kappa", base_classes(sim, kappa=False), mr.buffer),
     ]
     failed = int(np.count_nonzero(sim.mode[:n]))
     lines = [f"Classes at {args.checkpoint} (step {C.step}, {sim.t * 1e6:.2f} us): {n} points, "

@@ -257,15 +257,19 @@ class StepClasses:
         on = (corr.spring[:n] == CORRESPONDENCE) & (corr.mode[:n] == INTACT)
         return np.where(on, self.kfac, 1.0)
 
-    def base_classes(self, corr, step: int = 0) -> np.ndarray:
-        """Each owned point's class from its own material and state (module docstring)."""
+    def base_classes(self, corr, step: int = 0, kappa: bool = True, fracture: bool = True,
+                     fracture_class: int | None = None) -> np.ndarray:
+        """Each owned point's class from its own material and state (module docstring).
+        A study of the rule (benchmarks/class_rules.py) may leave out the family factor
+        (``kappa``) or the fracture rule (``fracture``), or change ``fracture_class``
+        (None: the scene's)."""
         n = self.n_owned
         if self._held is not None:
             return self._held
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
         now = np.full(n, np.inf)                        # dt_i / dt at the state now
         horizon = 2.0 * self.ratio * self.dt
-        kappa = self.family_factor(corr)
+        kappa = self.family_factor(corr) if kappa else np.ones(n)
         for g in corr.groups:
             idx = g.idx
             mu = 1.0 / corr.J_end[idx] - 1.0
@@ -288,8 +292,10 @@ class StepClasses:
         k = np.minimum(down, np.maximum(self.kbase[:n], up))
         # fracturing: a family that changed (bonds broke) within the last RECENT coarse
         # steps takes at most the fracture class (the finest by default)
-        recent = step - self.touched <= RECENT * self.ratio
-        k[recent] = np.minimum(k[recent], self.fracture_class)
+        if fracture:
+            recent = step - self.touched <= RECENT * self.ratio
+            fc = self.fracture_class if fracture_class is None else fracture_class
+            k[recent] = np.minimum(k[recent], fc)
         return k
 
     def _count_over(self, ratio, material, gid, step: int):
