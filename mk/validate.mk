@@ -28,12 +28,15 @@
 #   mpirun -n 2 mpipd run blast_paper --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_kappa
 # blast_paper_graded_contained (175ed73, the graded case with the contained gas and the class rule of §16, notes §17):
 #   mpirun -n 2 mpipd run blast_paper:graded --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_graded_contained
+# blast_paper_buffer_graded (ac55d26, the full 0.8 mm scene under the graded buffer, notes §18):
+#   mpirun -n 2 mpipd run blast_paper --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_buffer_graded
 # The record of 2026-12-03 (notes §12) was made from report folders for the four copper-only
 #   rows, whose run files were not on the machine: runs/rows/<case> = docs/validation/<case>
-#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them; the record of 2026-12-04 (notes §14) from report folders for all eight earlier rows (runs/rows/<case> = docs/validation/<case> at 19b1ac2) and runs/blast_paper_dx1.2_gas_contact/report; the record of 2026-12-04 (notes §15) the same, with runs/blast_paper_dx1.0/report after runs/rows/blast_paper_contained; the record of 2026-12-04 (notes §16) the same, with runs/blast_paper_kappa/report after runs/blast_paper_dx1.0/report; the record of 2026-12-04 (notes §17) from report folders for all eleven earlier rows (runs/rows/<case> = docs/validation/<case> at db5f253: the machine was new) with runs/blast_paper_graded_contained/report after runs/rows/blast_paper_kappa.
+#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them; the record of 2026-12-04 (notes §14) from report folders for all eight earlier rows (runs/rows/<case> = docs/validation/<case> at 19b1ac2) and runs/blast_paper_dx1.2_gas_contact/report; the record of 2026-12-04 (notes §15) the same, with runs/blast_paper_dx1.0/report after runs/rows/blast_paper_contained; the record of 2026-12-04 (notes §16) the same, with runs/blast_paper_kappa/report after runs/blast_paper_dx1.0/report; the record of 2026-12-04 (notes §17) from report folders for all eleven earlier rows (runs/rows/<case> = docs/validation/<case> at db5f253: the machine was new) with runs/blast_paper_graded_contained/report after runs/rows/blast_paper_kappa. The record of 2026-12-05 (notes §18) the same, with runs/blast_paper_buffer_graded/report after runs/blast_paper_graded_contained/report.
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
+    runs/blast_paper_buffer_graded/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
