@@ -54,16 +54,13 @@ def base_classes(sim, kappa=True, fracture=True, fracture_class=None):
 
 def spread(sim, kb, buffer):
     """The classes after the buffer ("full", "graded" or None) on one rank."""
-    from mpipd.kernels.classes import family_min
-    C, fam = sim.classes, sim.families
-    n = C.n_owned
+    from mpipd.model.multirate import buffered
+    C = sim.classes
     if buffer is None:
         return kb
     a = np.full(sim.points.n_local, C.top, np.uint8)
-    a[:n] = kb if buffer == "full" else np.minimum(kb.astype(np.int16) + 1, C.top)
-    out = np.empty(n, np.uint8)
-    family_min(fam.offsets, fam.nbr, a, out)
-    return out if buffer == "full" else np.minimum(out, kb)
+    a[:C.n_owned] = kb
+    return buffered(sim.families, a, C.top, buffer == "graded", np.empty(C.n_owned, np.uint8))
 
 
 def main(argv=None) -> int:

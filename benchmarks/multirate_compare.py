@@ -37,6 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from mpipd.output.writer import short_commit  # noqa: E402
+from postprocess.validation import evaluated_share  # noqa: E402
 
 
 def read(run_dir: Path) -> dict:
@@ -59,14 +60,9 @@ def read(run_dir: Path) -> dict:
 
 
 def evaluated(segments) -> float | None:
-    """The share of single-rate's bond states the run evaluated: each segment's
-    ``bond_states_evaluated`` weighted by its steps (None if a segment lacks it: runs
-    made before the segments kept it)."""
-    got = [(s["to_step"] - s["from_step"], s.get("bond_states_evaluated")) for s in segments]
-    if not got or any(v is None for _, v in got):
-        return None
-    steps = sum(n for n, _ in got)
-    return round(sum(n * v for n, v in got) / max(steps, 1), 4)
+    """postprocess.validation.evaluated_share, rounded for the table."""
+    share = evaluated_share(segments)
+    return None if share is None else round(share, 4)
 
 
 def lattice_rows(report: dict) -> list[tuple[str, str, object]]:

@@ -272,11 +272,10 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         differed, and ranks writing different strings corrupted ``segments``)."""
         done = sim.step_count - first
         w = team.max(wall)
-        share = sim.classes.evaluated_share(team) if sim.classes.enabled else 1.0
         return {"from_step": first, "to_step": sim.step_count, "ranks": team.size,
                 "wall_s": round(w, 3),
                 "bond_steps_per_s": sim.n_bonds_global * done / w if w > 0 else None,
-                "bond_states_evaluated": round(share, 4)}
+                "bond_states_evaluated": round(sim.classes.evaluated_share(team), 4)}
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
                        checkpointer=checkpointer)

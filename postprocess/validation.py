@@ -270,14 +270,19 @@ def _wall(segments, steps=None) -> str:
             f"{'/'.join(map(str, ranks))} rank(s){gaps})")
 
 
-def _evaluated(segments) -> str:
-    """The share of single-rate's bond states over a run's invocations, each weighted
-    by its steps."""
+def evaluated_share(segments) -> float | None:
+    """The share of single-rate's bond states a run evaluated: each segment's
+    ``bond_states_evaluated`` weighted by its steps; None if a segment lacks it (runs
+    made before the segments kept it)."""
     if not segments or any(s.get("bond_states_evaluated") is None for s in segments):
-        return NOT_RECORDED
+        return None
     n = [s["to_step"] - s["from_step"] for s in segments]
-    share = sum(k * s["bond_states_evaluated"] for k, s in zip(n, segments)) / max(sum(n), 1)
-    return f"{share:.3f}"
+    return sum(k * s["bond_states_evaluated"] for k, s in zip(n, segments)) / max(sum(n), 1)
+
+
+def _evaluated(segments) -> str:
+    share = evaluated_share(segments)
+    return NOT_RECORDED if share is None else f"{share:.3f}"
 
 
 def _throughput(segments, steps=None) -> str:

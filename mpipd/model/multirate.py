@@ -269,7 +269,7 @@ class StepClasses:
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
         now = np.full(n, np.inf)                        # dt_i / dt at the state now
         horizon = 2.0 * self.ratio * self.dt
-        kappa = self.family_factor(corr) if kappa else np.ones(n)
+        kap = self.family_factor(corr) if kappa else np.ones(n)
         for g in corr.groups:
             idx = g.idx
             mu = 1.0 / corr.J_end[idx] - 1.0
@@ -280,7 +280,7 @@ class StepClasses:
             c = np.maximum(c_now, g.material.p_wave_speed_at(mu_ahead))
             lam = np.empty(len(idx))
             min_stretch(corr.V, idx, corr.spring, corr.mode, lam)
-            lam *= kappa[idx]
+            lam *= kap[idx]
             now[idx] = self.dtc[idx] * lam * self.cp0[idx] / c_now / self.dt
             r[idx] = self.safety * now[idx] * c_now / c
         self._count_over(now, corr.points.material[:n], corr.points.gid, step)
@@ -360,12 +360,7 @@ class StepClasses:
         ("graded")."""
         n, fam = self.n_owned, self.families
         halo.exchange(self.kbase)
-        if self.graded:
-            up = np.minimum(self.kbase.astype(np.int16) + 1, self.top).astype(np.uint8)
-            family_min(fam.offsets, fam.nbr, up, self.klass[:n])
-            np.minimum(self.klass[:n], self.kbase[:n], out=self.klass[:n])
-        else:
-            family_min(fam.offsets, fam.nbr, self.kbase, self.klass[:n])
+        buffered(fam, self.kbase, self.top, self.graded, self.klass[:n])
         halo.exchange(self.klass)
         family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
         self._recount()
@@ -403,7 +398,9 @@ class StepClasses:
     def evaluated_share(self, team) -> float:
         """The bond states this invocation evaluated over those single-rate steps
         would have (collective): sum over steps of the bonds of the acting classes,
-        over steps x all bonds."""
+        over steps x all bonds; 1 single-rate."""
+        if not self.enabled:
+            return 1.0
         ev = team.sum(np.array([self.evaluated, float(self.steps)]))
         total = team.sum(np.array([float(self.fam_bonds.sum())]))[0]
         return float(ev[0] / max(ev[1] / team.size * total, 1.0))
@@ -416,6 +413,19 @@ class StepClasses:
             sel = k == c
             out[c] = (int(sel.sum()), int(n_bonds_of[sel].sum()))
         return out
+
+
+def buffered(families, kbase, top: int, graded: bool, out) -> np.ndarray:
+    """out[i] (the owned points) = the class after the buffer from the base classes
+    ``kbase`` of the owned points and ghosts: min over i's family of base_j (full), or
+    min(base_i, min over i's family of base_j + 1) (graded)."""
+    if graded:
+        up = np.minimum(kbase.astype(np.int16) + 1, top).astype(np.uint8)
+        family_min(families.offsets, families.nbr, up, out)
+        np.minimum(out, kbase[:len(out)], out=out)
+    else:
+        family_min(families.offsets, families.nbr, kbase, out)
+    return out
 
 
 def coarsening_margin(rest, top: int) -> np.ndarray:
