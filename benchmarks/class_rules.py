@@ -14,7 +14,7 @@ spreads it with each buffer.  Nothing of the run is written.  The variants:
 * no buffer (every point at its own base class);
 * without the fracture rule (a family that lost bonds in the last coarse steps);
 * the fracture rule at class 1 instead of 0;
-* without the family factor kappa.
+* the other family factor (row sum or shape tensor), and none.
 """
 from __future__ import annotations
 
@@ -48,8 +48,20 @@ def base_classes(sim, kappa=True, fracture=True, fracture_class=None):
     """StepClasses.base_classes at the current state, with the family factor on or off
     and the fracture rule on (at ``fracture_class``, None: the scene's) or off."""
     C = sim.classes
-    return C.base_classes(sim.corr, C.step, kappa=kappa, fracture=fracture,
+    return C.base_classes(sim.corr, sim.halo, C.step, kappa=kappa, fracture=fracture,
                           fracture_class=fracture_class)
+
+
+def other_factor(sim, kind):
+    """base_classes with the family factor ``kind`` (its factors from scratch), then
+    the scene's again."""
+    C = sim.classes
+    scene_kind = C.factor_kind
+    C.factor_kind, C.kfac = kind, None
+    try:
+        return base_classes(sim)
+    finally:
+        C.factor_kind, C.kfac = scene_kind, None
 
 
 def spread(sim, kb, buffer):
@@ -82,13 +94,16 @@ def main(argv=None) -> int:
     other = "full" if mr.buffer == "graded" else "graded"
     fc = mr.fracture_class
     rule = base_classes(sim)
+    kind = "shape_tensor" if mr.family_factor == "row_sum" else "row_sum"
     rows = [
-        (f"the rule (buffer {mr.buffer}, fracture class {fc})", rule, mr.buffer),
+        (f"the rule (buffer {mr.buffer}, fracture class {fc}, family factor {mr.family_factor})",
+         rule, mr.buffer),
         (f"buffer {other}", rule, other),
         ("no buffer", rule, None),
         ("no fracture rule", base_classes(sim, fracture=False), mr.buffer),
         (f"fracture class {1 if fc == 0 else 0}", base_classes(sim, fracture_class=1 if fc == 0 else 0),
          mr.buffer),
+        (f"family factor {kind}", other_factor(sim, kind), mr.buffer),
         ("no family factor kappa", base_classes(sim, kappa=False), mr.buffer),
     ]
     failed = int(np.count_nonzero(sim.mode[:n]))

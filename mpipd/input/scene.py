@@ -84,11 +84,14 @@ class Multirate:
     point's class follows its family's, "full" (no coarser than any point it pushes)
     or "graded" (at most one class coarser: a step ratio of 2 across any bond);
     ``fracture_class``: the class a point whose family lost bonds in the last coarse
-    steps takes at most (docs/multirate.md, The class rule)."""
+    steps takes at most; ``family_factor``: how a point's stable step follows the
+    bonds it and its neighbours lost, "row_sum" (the Gershgorin row sum at the point)
+    or "shape_tensor" (lambda_min of its own K) (docs/multirate.md, The class rule)."""
     max_ratio: int = 4
     safety: float = 0.5
     buffer: str = "graded"
     fracture_class: int = 0
+    family_factor: str = "row_sum"
 
     def check(self, path):
         if self.max_ratio not in MAX_RATIOS:
@@ -100,6 +103,9 @@ class Multirate:
         if self.buffer not in BUFFERS:
             fail(join(path, "buffer"), "buffer must be one of "
                  + ", ".join(f'"{b}"' for b in BUFFERS) + f" (got {self.buffer!r})")
+        if self.family_factor not in FAMILY_FACTORS:
+            fail(join(path, "family_factor"), "family_factor must be one of "
+                 + ", ".join(f'"{b}"' for b in FAMILY_FACTORS) + f" (got {self.family_factor!r})")
         top = self.max_ratio.bit_length() - 1
         if not 0 <= self.fracture_class <= top:
             fail(join(path, "fracture_class"), f"fracture_class must be a class 0..{top} of "
@@ -110,6 +116,8 @@ class Multirate:
 MAX_RATIOS = (1, 2, 4, 8)
 #: how a point's class follows its family's (mpipd.model.multirate.StepClasses._spread)
 BUFFERS = ("full", "graded")
+#: how a point's stable step follows its family (mpipd.model.multirate.FAMILY_FACTORS)
+FAMILY_FACTORS = ("row_sum", "shape_tensor")
 
 
 @dataclass(frozen=True)

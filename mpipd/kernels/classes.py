@@ -9,6 +9,8 @@ asynchronous variational integrators: each state's impulse at its own times).
 Single-rate integration is level 0 with every class 0: every weight is 1.0,
 and x * 1.0 == x, so the kernels give the single-rate numbers bit for bit.
 """
+import math
+
 import numba
 
 from .layout import CORRESPONDENCE, INTACT
@@ -56,6 +58,81 @@ def largest_eigenvalue(A, out):
     """out[i] = the largest eigenvalue of the symmetric 3x3 A[i] (its symmetric part)."""
     for i in range(A.shape[0]):
         out[i], _ = _sym_max_min(A, i)
+
+
+@numba.njit(cache=True)
+def element_sums(x, vol, wi, offsets, nbr, broken, Kinv, on, rows, E):
+    """The correspondence element of each owned point i in ``rows``, for
+    :func:`row_sums`: F_i - I = sum_j (u_j - u_i) (x) B_ij over i's intact bonds
+    (Eq. 5) with B_ij = omega_i V_j K_i^-1 xi_ij and the centre's weight
+    B_ii = -sum_j B_ij.  E[i, 0:9] = K_i^-1, E[i, 9] = S_i = |B_ii| + sum_j |B_ij|,
+    E[i, 10] = |B_ii|; all 0 where ``on[i]`` is 0 (no correspondence element: the
+    gas, K not invertible).  ``wi``: the bonds' omega_i (nosb.bond_influence)."""
+    for r in range(rows.shape[0]):
+        i = rows[r]
+        for c in range(11):
+            E[i, c] = 0.0
+        if not on[i]:
+            continue
+        K = Kinv[i]
+        s = c0 = c1 = c2 = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            if broken[b]:
+                continue
+            j = nbr[b]
+            e0 = x[j, 0] - x[i, 0]
+            e1 = x[j, 1] - x[i, 1]
+            e2 = x[j, 2] - x[i, 2]
+            w = wi[b] * vol[j]
+            b0 = w * (K[0, 0] * e0 + K[0, 1] * e1 + K[0, 2] * e2)
+            b1 = w * (K[1, 0] * e0 + K[1, 1] * e1 + K[1, 2] * e2)
+            b2 = w * (K[2, 0] * e0 + K[2, 1] * e1 + K[2, 2] * e2)
+            s += math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+            c0 += b0
+            c1 += b1
+            c2 += b2
+        bc = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        for a in range(3):
+            for c in range(3):
+                E[i, 3 * a + c] = K[a, c]
+        E[i, 9] = s + bc
+        E[i, 10] = bc
+
+
+@numba.njit(cache=True)
+def row_sums(x, vol, wj, offsets, nbr, broken, E, rows, R):
+    """R[a] for each owned point a in ``rows``: the Gershgorin row sum of the
+    correspondence stiffness at a, per unit modulus and mass.  The element of
+    point e has the stiffness V_e B_e^T C B_e (its weights B_e.: :func:`element_sums`),
+    whose block (a, c) is bounded by V_e M |B_ea| |B_ec| (M: the largest modulus of
+    C), so that row a of the assembled stiffness over the mass rho V_a sums to at
+    most (M / rho) R_a with
+
+        R_a = (1 / V_a) sum over the elements e that hold a of V_e |B_ea| S_e
+            = |B_aa| S_a + sum over a's intact bonds (a, e) of V_e omega_e |K_e^-1 xi_ae| S_e
+
+    (families are symmetric: e holds a iff a holds e; B_ea = omega_e V_a K_e^-1 xi_ea).
+    The largest eigenvalue of M^-1 K is below max_a (M / rho) R_a (Gershgorin), so
+    sqrt(R_a) bounds the frequency a point can carry.  E holds every local point's
+    element (owned and ghosts); ``wj``: the bonds' omega_j."""
+    for r in range(rows.shape[0]):
+        a = rows[r]
+        acc = E[a, 10] * E[a, 9]
+        for b in range(offsets[a], offsets[a + 1]):
+            if broken[b]:
+                continue
+            e = nbr[b]
+            se = E[e, 9]
+            if se == 0.0:
+                continue
+            e0 = x[a, 0] - x[e, 0]
+            e1 = x[a, 1] - x[e, 1]
+            e2 = x[a, 2] - x[e, 2]
+            b0 = E[e, 0] * e0 + E[e, 1] * e1 + E[e, 2] * e2
+            b1 = E[e, 3] * e0 + E[e, 4] * e1 + E[e, 5] * e2
+            b2 = E[e, 6] * e0 + E[e, 7] * e1 + E[e, 8] * e2
+            acc += vol[e] * wj[b] * math.sqrt(b0 * b0 + b1 * b1 + b2 * b2) * se
+        R[a] = acc
 
 
 @numba.njit(cache=True, inline="always")

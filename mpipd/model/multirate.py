@@ -52,12 +52,32 @@ on the current configuration).  That is exact for an isochoric thinning, the
 plastic flow of a metal (the density and c are unchanged; a 1-D element of length
 lambda L with A = A0 / lambda has the stiffness k0 / lambda^2, so omega_max and
 1/dt_crit scale with 1/lambda); under compression c(state) and lambda both count
-it, which errs on the safe side.  kappa_i = min(1, sqrt(lambda_min(K_i) /
-lambda_min(K_i^0))) follows the family (``StepClasses.family_factor``): the force
-state omega P K^-1 xi, with P linear in F = N K^-1, makes the element's stiffness
-scale with K^-1, its largest eigenvalue with 1 / lambda_min(K), and so its stable
-step with lambda_min(K)^1/2; a point whose family lost the bonds on one side (a
-crack face, the crushed zone) steps finer for as long as it stays so.  A copper tube driven to 2.4 x its radius is
+it, which errs on the safe side.  kappa_i follows the bonds lost around the point
+(``StepClasses.family_factor``, the scene's ``family_factor``):
+
+* "row_sum" (the default): kappa_i = min(1, sqrt(R_i^0 / R_i)), R_i the Gershgorin row
+  sum of the correspondence stiffness at point i over the elements that hold it
+  (``kernels.classes.row_sums``; R_i^0 over the whole reference families).  The
+  largest eigenvalue of M^-1 K is at most the largest row sum (Gershgorin), and the
+  stable step of the central difference is 2 / omega_max, so a point whose row sum
+  grew by R_i / R_i^0 needs its step shortened by at most sqrt of it.  It counts every
+  element a point takes impulses from, its own and its neighbours', each with the
+  bonds it still has; a free surface and a crack face look alike (each relative to
+  its own reference).  Measured (benchmarks/family_factor.py,
+  docs/multirate_family_factor.md): a granite block with a planar crack, two crossed
+  cracks or a ball with 30 % of its bonds broken keeps the intact block's critical
+  step; balls with 60-95 % broken lose 13-89 % of it, never more than the row sum says.
+* "shape_tensor": kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) of the
+  point's own element (the force state omega P K^-1 xi, P linear in F = N K^-1: the
+  element's largest eigenvalue scales with 1 / lambda_min(K)).  It errs on the safe
+  side by far (a crack face: 0.68 where the step is unchanged; 95 % of a ball's bonds
+  broken: 0.001 where 0.11-0.17 is measured) and holds most of a fractured specimen
+  in the finer classes.
+
+Both are 1 off the correspondence force (the gas, the bond-spring fallback) and at a
+point that failed (its own stress no longer follows its material), as the smallest
+stretch is, and are recomputed where a family changed (bonds broke) and, for the
+row sum, around it.  A copper tube driven to 2.4 x its radius is
 thinned to lambda = 0.25 (docs/validation_notes.md §13).  A point whose dt_i is
 below dt itself cannot be helped by any class (class 0 is dt): the boundary
 counts it (``over``), and the run log and the error of an unstable run name the
@@ -82,8 +102,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import family_min, largest_eigenvalue, min_stretch
-from ..kernels.layout import CORRESPONDENCE, INTACT
+from ..kernels.classes import element_sums, family_min, largest_eigenvalue, min_stretch, row_sums
+from ..kernels.layout import CORRESPONDENCE, INTACT, NOT_TL, SPRING_F
 from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
@@ -124,6 +144,7 @@ class StepClasses:
         #: the buffer: a class no coarser than any pushed point's ("full") or at most one
         #: class coarser ("graded"); the class a fracturing family takes at most
         self.graded = mr is not None and mr.buffer == "graded"
+        self.factor_kind = mr.family_factor if mr is not None else "row_sum"
         self.fracture_class = mr.fracture_class if mr is not None else 0
         self.top = self.ratio.bit_length() - 1
         self.dt = scene.time.dt
@@ -154,8 +175,10 @@ class StepClasses:
         self.over_first = -1
         self.over_worst = {}                            # material id -> (dt_i / dt, gid)
         self.over_now = 0                               # points over dt at the last boundary
-        #: family_factor: 1/lambda_min(K^0), the factor kept, the rows to recompute
+        #: family_factor: its reference (1/lambda_min(K^0), or R^0), the factor kept, the
+        #: rows to recompute; the row sum's element data (owned and ghosts) and R now
         self.kref = self.kfac = self.stale = None
+        self.elem = self.rnow = None
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -234,30 +257,21 @@ class StepClasses:
             if self.kfac is not None:
                 self.stale[rows] = True
 
-    def family_factor(self, corr) -> np.ndarray:
-        """kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) of every owned
-        point (K: Eq. 4 over the intact bonds, K^0 over the whole reference family),
-        1 off the correspondence force or once failed (module docstring).  Kept per
-        point and recomputed where the family changed (:meth:`touch`)."""
+    def family_factor(self, corr, halo) -> np.ndarray:
+        """kappa_i of every owned point (module docstring; the scene's ``family_factor``),
+        1 off the correspondence force and once failed.  Kept per point and recomputed where a family
+        changed (:meth:`touch`) and, for the row sum, around it.  Collective (halo)."""
         n = self.n_owned
-        if self.kfac is None:                           # first use, or after a restart
-            self.kref = np.empty(n)
-            largest_eigenvalue(corr.reference_kinv(), self.kref)    # 1 / lambda_min(K^0)
+        first = self.kfac is None                       # first use, or after a restart
+        if first:
             self.kfac = np.ones(n)
             self.stale = np.ones(n, bool)
-        rows = np.flatnonzero(self.stale)
-        if len(rows):
-            e = np.empty(len(rows))
-            largest_eigenvalue(corr.Kinv[rows], e)                  # 1 / lambda_min(K)
-            ok = e > 0.0
-            f = np.ones(len(rows))
-            f[ok] = np.sqrt(self.kref[rows[ok]] / e[ok])
-            self.kfac[rows] = np.minimum(1.0, f)
-            self.stale[rows] = False
+        FAMILY_FACTORS[self.factor_kind](self, corr, halo, first)
+        self.stale[:] = False
         on = (corr.spring[:n] == CORRESPONDENCE) & (corr.mode[:n] == INTACT)
         return np.where(on, self.kfac, 1.0)
 
-    def base_classes(self, corr, step: int = 0, kappa: bool = True, fracture: bool = True,
+    def base_classes(self, corr, halo, step: int = 0, kappa: bool = True, fracture: bool = True,
                      fracture_class: int | None = None) -> np.ndarray:
         """Each owned point's class from its own material and state (module docstring).
         A study of the rule (benchmarks/class_rules.py) may leave out the family factor
@@ -269,7 +283,7 @@ class StepClasses:
         r = np.zeros(n)                                 # the gas, and any point in no group: 0
         now = np.full(n, np.inf)                        # dt_i / dt at the state now
         horizon = 2.0 * self.ratio * self.dt
-        kap = self.family_factor(corr) if kappa else np.ones(n)
+        kap = self.family_factor(corr, halo) if kappa else np.ones(n)
         for g in corr.groups:
             idx = g.idx
             mu = 1.0 / corr.J_end[idx] - 1.0
@@ -341,7 +355,7 @@ class StepClasses:
             return False
         n = self.n_owned
         self.previous = self.klass.copy()
-        self.kbase[:n] = self.base_classes(corr, step)
+        self.kbase[:n] = self.base_classes(corr, halo, step)
         self._spread(halo)
         self.boundaries += 1
         return bool(np.any(self.klass[:n] != self.previous[:n]))
@@ -413,6 +427,69 @@ class StepClasses:
             sel = k == c
             out[c] = (int(sel.sum()), int(n_bonds_of[sel].sum()))
         return out
+
+
+def shape_tensor_factor(cl, corr, halo, first: bool):
+    """kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) at the stale rows of
+    ``cl`` (StepClasses), from the point's own shape tensor (module docstring)."""
+    n = cl.n_owned
+    if first:
+        cl.kref = np.empty(n)
+        largest_eigenvalue(corr.reference_kinv(), cl.kref)          # 1 / lambda_min(K^0)
+    rows = np.flatnonzero(cl.stale)
+    if len(rows):
+        e = np.empty(len(rows))
+        largest_eigenvalue(corr.Kinv[rows], e)                      # 1 / lambda_min(K)
+        ok = e > 0.0
+        f = np.ones(len(rows))
+        f[ok] = np.sqrt(cl.kref[rows[ok]] / e[ok])
+        cl.kfac[rows] = np.minimum(1.0, f)
+
+
+def row_sum_factor(cl, corr, halo, first: bool):
+    """kappa_i = min(1, sqrt(R_i^0 / R_i)) (module docstring): the elements of the
+    stale rows of ``cl`` (StepClasses) again (kernels.classes.element_sums), their
+    data to the ghosts, and R again at every owned point whose closed family holds a
+    changed element (kernels.classes.row_sums).  Collective (halo)."""
+    p, fam = corr.points, cl.families
+    n, nl = p.n_owned, p.n_local
+    if first:
+        owned = np.arange(n, dtype=np.int64)
+        whole = np.zeros_like(fam.broken)
+        kref = corr.reference_kinv()
+        on = ((corr.spring[:n] != NOT_TL) & kref.any(axis=(1, 2))).astype(np.uint8)
+        cl.elem = np.zeros((nl, 11))
+        element_sums(p.x, p.volume, corr.omega_i, fam.offsets, fam.nbr, whole, kref, on,
+                     owned, cl.elem)
+        halo.exchange(cl.elem)
+        cl.kref = np.zeros(n)
+        row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, whole, cl.elem, owned,
+                 cl.kref)
+        cl.rnow = cl.kref.copy()
+        cl.changed = np.zeros(nl, np.uint8)
+    rows = np.flatnonzero(cl.stale)
+    s = corr.spring[:n]
+    on = ((s == CORRESPONDENCE) | (s == SPRING_F)).astype(np.uint8)   # K invertible
+    element_sums(p.x, p.volume, corr.omega_i, fam.offsets, fam.nbr, fam.broken, corr.Kinv,
+                 on, rows, cl.elem)
+    cl.changed[:] = 0
+    cl.changed[rows] = 1
+    halo.exchange(cl.elem, cl.changed)
+    same = np.empty(n, np.uint8)
+    family_min(fam.offsets, fam.nbr, 1 - cl.changed, same)
+    redo = np.flatnonzero(same == 0)
+    if len(redo):
+        row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, fam.broken, cl.elem,
+                 redo, cl.rnow)
+        r = cl.rnow[redo]
+        f = np.ones(len(redo))
+        ok = r > 0.0
+        f[ok] = np.sqrt(cl.kref[redo[ok]] / r[ok])
+        cl.kfac[redo] = np.minimum(1.0, f)
+
+
+#: the scene's ``family_factor`` (mpipd.input.scene.FAMILY_FACTORS)
+FAMILY_FACTORS = {"row_sum": row_sum_factor, "shape_tensor": shape_tensor_factor}
 
 
 def buffered(families, kbase, top: int, graded: bool, out) -> np.ndarray:
