@@ -403,9 +403,10 @@ def test_row_sum_factor_against_the_stiffness_row_sums_built_from_their_definiti
     R the Gershgorin row sum of the correspondence stiffness at a
     (kernels.classes.row_sums), against R built element by element in the test
     (:func:`_row_sums_by_definition`), in a bar whose points take class 3 at rest, cut
-    across by a crack (every bond crossing the plane x = x0 broken, both ways).  The
-    points next to the crack step finer by floor(log2(r0 kappa)); the factor is 1 a
-    horizon and more from it, and 1 at a failed point."""
+    by a crack (every bond crossing the plane x = x0 broken, both ways) and, beside it,
+    a ball with 90 % of its bonds broken.  The points there step finer by
+    floor(log2(r0 kappa)), the ball's more than the crack's; the factor is 1 two
+    horizons from both, and 1 at a failed point."""
     sim = bar_at_rest_ratio(10.0, 8)
     cl, corr, p, fam = sim.classes, sim.corr, sim.points, sim.families
     n = p.n_owned
@@ -415,23 +416,30 @@ def test_row_sum_factor_against_the_stiffness_row_sums_built_from_their_definiti
     assert np.all(got0 == 1.0)                          # intact: kappa = 1 everywhere
     R0 = _row_sums_by_definition(p, fam, n, np.zeros_like(fam.broken))
     assert np.allclose(cl.kref, R0, rtol=1e-9)
-    x0 = 0.0481
+    x0, xb = 0.0301, 0.066
     i = np.repeat(np.arange(n), np.diff(fam.offsets))
-    cross = (p.x[i, 0] < x0) != (p.x[fam.nbr, 0] < x0)
-    fam.broken[cross] = 1
-    cut = np.unique(i[cross])
+    j = fam.nbr
+    cross = (p.x[i, 0] < x0) != (p.x[j, 0] < x0)
+    c = np.array([xb, 0.003, 0.003])
+    inside = (np.linalg.norm(p.x[i] - c, axis=1) < 0.003) | (np.linalg.norm(p.x[j] - c, axis=1) < 0.003)
+    lo, hi = np.minimum(p.gid[i], p.gid[j]), np.maximum(p.gid[i], p.gid[j])
+    crushed = inside & ((lo * 1000003 + hi * 7919) % 10007 < 0.9 * 10007)
+    fam.broken[cross | crushed] = 1
+    cut = np.unique(i[cross | crushed])
     cl.touch(cut)
     corr.rebuild_shape(cut)
     got = cl.family_factor(corr, sim.halo)
     R = _row_sums_by_definition(p, fam, n, fam.broken)
     want = np.minimum(1.0, np.sqrt(R0 / R))
     assert np.allclose(got, want, rtol=1e-9)
-    face = np.abs(p.x[:n, 0] - x0) < 0.5 * 1e-3
-    far = np.abs(p.x[:n, 0] - x0) > 2.0 * p.horizon[:n]
-    assert 0.5 < got[face].min() < 0.95             # a crack face: the square root of a
-    assert np.all(got[far] == 1.0)                  # bounded growth of its row sum
+    face = np.abs(p.x[:n, 0] - x0) < 1e-3
+    ball = np.linalg.norm(p.x[:n] - c, axis=1) < 0.003
+    far = (np.abs(p.x[:n, 0] - x0) > 2.0 * p.horizon[:n]) & (np.abs(p.x[:n, 0] - xb) > 0.003 + 2.0 * p.horizon[:n])
+    assert 0.6 < got[face].min() < 0.95             # a crack face
+    assert got[ball].min() < got[face].min()        # a crushed neighbourhood: finer
+    assert np.all(got[far] == 1.0)
     k = cl.base_classes(corr, sim.halo, step=10_000)            # long after the breakage
-    j = int(np.argmin(np.where(face, got, 2.0)))
+    j = int(np.argmin(np.where(ball, got, 2.0)))
     assert k[j] == min(3, int(np.floor(np.log2(r0 * got[j]))))
     from mpipd.kernels.layout import MODE_TENSION
     corr.mode[j] = MODE_TENSION
@@ -503,3 +511,26 @@ def test_a_crushed_ball_is_stable_under_the_class_rule_and_not_at_the_coarse_cla
     assert _energy_growth(sim) == pytest.approx(1.0, abs=1e-3)
 
 
+
+
+def test_the_rows_around_changed_elements_on_a_graph_with_ghosts():
+    """kernels.classes.around (the row sums recomputed after a family changed) against
+    the closed-family test done bond by bond: a random symmetric graph on 60 local
+    points, of which the first 40 are owned (rows stored) and 20 ghosts, random flags."""
+    from mpipd.kernels.classes import around
+    rng = np.random.default_rng(7)
+    nl, n = 60, 40
+    adj = rng.random((nl, nl)) < 0.08
+    adj = np.triu(adj, 1)
+    adj = adj | adj.T
+    nbr = [np.flatnonzero(adj[a]) for a in range(n)]
+    offsets = np.concatenate(([0], np.cumsum([len(x) for x in nbr]))).astype(np.int64)
+    nbr = np.concatenate(nbr).astype(np.int32)
+    edge = np.array([a for a in range(n) if np.any(adj[a, n:])], np.int64)
+    for trial in range(20):
+        flag = (rng.random(nl) < 0.05).astype(np.uint8)
+        changed = np.flatnonzero(flag[:n]).astype(np.int64)
+        out = np.empty(n, np.uint8)
+        around(offsets, nbr, flag, changed, edge, n, out)
+        want = np.array([flag[a] or np.any(flag[adj[a]]) for a in range(n)], np.uint8)
+        np.testing.assert_array_equal(out, want)

@@ -36,6 +36,30 @@ def family_min(offsets, nbr, a, out):
 
 
 @numba.njit(cache=True)
+def around(offsets, nbr, flag, changed, edge, n, out):
+    """out[a] = 1 for every owned a whose closed family holds a flagged point (owned or
+    ghost), 0 elsewhere, reading only the families of the flagged owned points
+    ``changed`` (families are symmetric: a flagged e marks its owned neighbours) and of
+    the owned points ``edge`` that have ghosts in their families (a flagged ghost)."""
+    for a in range(n):
+        out[a] = 0
+    for r in range(changed.shape[0]):
+        e = changed[r]
+        out[e] = 1
+        for b in range(offsets[e], offsets[e + 1]):
+            if nbr[b] < n:
+                out[nbr[b]] = 1
+    for r in range(edge.shape[0]):
+        a = edge[r]
+        if out[a]:
+            continue
+        for b in range(offsets[a], offsets[a + 1]):
+            if flag[nbr[b]]:
+                out[a] = 1
+                break
+
+
+@numba.njit(cache=True)
 def min_stretch(V, idx, spring, mode, out):
     """out[k] = min(1, lambda_min(V_i)) for i = idx[k]: the smallest principal stretch
     (eigenvalue of the left stretch V, F = V R) of an intact point on the

@@ -102,7 +102,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import element_sums, family_min, largest_eigenvalue, min_stretch, row_sums
+from ..kernels.classes import (around, element_sums, family_min, largest_eigenvalue,
+                               min_stretch, row_sums)
 from ..kernels.layout import CORRESPONDENCE, INTACT, NOT_TL, SPRING_F
 from ..state import AUX, LOCAL
 
@@ -178,7 +179,7 @@ class StepClasses:
         #: family_factor: its reference (1/lambda_min(K^0), or R^0), the factor kept, the
         #: rows to recompute; the row sum's element data (owned and ghosts) and R now
         self.kref = self.kfac = self.stale = None
-        self.elem = self.rnow = None
+        self.elem = self.rnow = self.changed = self.edge = None
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -467,6 +468,9 @@ def row_sum_factor(cl, corr, halo, first: bool):
                  cl.kref)
         cl.rnow = cl.kref.copy()
         cl.changed = np.zeros(nl, np.uint8)
+        ghosts = np.zeros(n, np.uint8)                  # owned points with ghost neighbours
+        family_min(fam.offsets, fam.nbr, (np.arange(nl) < n).astype(np.uint8), ghosts)
+        cl.edge = np.flatnonzero(ghosts == 0)
     rows = np.flatnonzero(cl.stale)
     s = corr.spring[:n]
     on = ((s == CORRESPONDENCE) | (s == SPRING_F)).astype(np.uint8)   # K invertible
@@ -475,9 +479,9 @@ def row_sum_factor(cl, corr, halo, first: bool):
     cl.changed[:] = 0
     cl.changed[rows] = 1
     halo.exchange(cl.elem, cl.changed)
-    same = np.empty(n, np.uint8)
-    family_min(fam.offsets, fam.nbr, 1 - cl.changed, same)
-    redo = np.flatnonzero(same == 0)
+    near = np.empty(n, np.uint8)
+    around(fam.offsets, fam.nbr, cl.changed, rows, cl.edge, n, near)
+    redo = np.flatnonzero(near)
     if len(redo):
         row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, fam.broken, cl.elem,
                  redo, cl.rnow)
