@@ -102,8 +102,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import (around, element_sums, family_min, largest_eigenvalue,
-                               min_stretch, row_sums)
+from ..kernels.classes import around, element_sums, family_min, largest_eigenvalue, min_stretch, row_sums
 from ..kernels.layout import CORRESPONDENCE, INTACT, NOT_TL, SPRING_F
 from ..state import AUX, LOCAL
 
