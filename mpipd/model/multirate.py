@@ -405,7 +405,7 @@ class StepClasses:
                         for k in range(self.top + 1))
         buffer = "graded" if self.graded else "full"
         return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}, {buffer} buffer, "
-                f"fracture class {self.fracture_class}): now {cls}; "
+                f"fracture class {self.fracture_class}, family factor {self.factor_kind}): now {cls}; "
                 f"bond states evaluated {share:.3f} of single-rate's; classes changed at "
                 f"{self.changes} of {self.boundaries} coarse steps (a change of the forces gathered at each)")
 

@@ -1,0 +1,69 @@
+"""The JH2 ring of tests/test_multirate.py::test_state_following_classes_and_the_ledger
+under each buffer and each family factor (docs/multirate.md, The family factor): the
+ledger's largest balance at the coarse boundaries, the share of single-rate's bond
+states evaluated, the failed points and the classes at the end.
+
+    python benchmarks/ring_factors.py [--out FILE]
+
+One rank, about 2 minutes.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+#: the test's scene overrides (granite_ring at safety 0.9, refresh after breakage)
+OVER = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
+        "solver.refresh_after_break=true"]
+
+
+def run(buffer: str, factor: str):
+    from mpi4py import MPI
+
+    from mpipd.input import scene as sc
+    from mpipd.parallel.team import Team
+    from mpipd.solver import Simulation
+    over = OVER + [f'time.multirate={{max_ratio=4, safety=0.9, buffer="{buffer}", '
+                   f'family_factor="{factor}"}}']
+    scene, _ = sc.load("granite_ring", over)
+    sim = Simulation(scene, Team(MPI.COMM_SELF))
+    n = sim.points.n_owned
+    worst = 0.0
+    while sim.step_count < scene.time.n_steps:
+        sim.step()
+        if sim.at_boundary and sim.step_count % 40 == 0:
+            worst = max(worst, abs(sim.energies().balance))
+    k = np.bincount(sim.classes.klass[:n], minlength=3)
+    return worst, sim.classes.evaluated_share(sim.team), int(np.count_nonzero(sim.mode[:n])), k
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", help="also write the table (markdown) here")
+    args = ap.parse_args(argv)
+    from mpipd.input.scene import BUFFERS, FAMILY_FACTORS
+    lines = ["granite_ring (3780 points, JH2, tension failure, contact, viscosity), max_ratio 4, "
+             "safety 0.9, 96 steps (`python benchmarks/ring_factors.py`).", "",
+             "| buffer | family factor | largest ledger balance | bond states evaluated | "
+             "failed points | classes 0 / 1 / 2 at the end |", "|---|---|---|---|---|---|"]
+    for buffer in BUFFERS:
+        for factor in FAMILY_FACTORS:
+            bal, share, failed, k = run(buffer, factor)
+            lines.append(f"| {buffer} | {factor} | {bal:.2e} | {share:.3f} | {failed} | "
+                         f"{' / '.join(str(int(x)) for x in k)} |")
+            print(lines[-1], flush=True)
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.out:
+        Path(args.out).write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
