@@ -26,6 +26,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from tables import emit  # noqa: E402
 
 
 def restore(path, overrides):
@@ -117,10 +120,7 @@ def main(argv=None) -> int:
         per = np.bincount(k, weights=bonds, minlength=C.top + 1)
         lines.append(f"| {name} | {' / '.join(str(int(x)) for x in pts)} | "
                      f"{' / '.join(f'{x / 1e6:.2f}' for x in per)} | {projected_cost(per):.3f} |")
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    emit(lines, args.out)
     return 0
 
 

@@ -27,6 +27,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from tables import emit  # noqa: E402
 
 DX = 8e-4
 CASES = ("intact", "plane crack", "crossed cracks", "ball 30 %", "ball 60 %", "ball 80 %",
@@ -172,10 +175,7 @@ def main(argv=None) -> int:
         lines.append(f"| {case} | {broken} | " + " | ".join(f"{fac[k]:.3f}" for k in kinds)
                      + f" | {crit} | {ratio} | "
                      + " | ".join(f"{lo / (SAFETY * fac[k]):.1f}" for k in kinds) + " |")
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    emit(lines, args.out)
     return 0
 
 

@@ -17,6 +17,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from tables import emit  # noqa: E402
 
 #: the test's scene overrides (granite_ring at safety 0.9, refresh after breakage)
 OVER = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
@@ -58,10 +61,7 @@ def main(argv=None) -> int:
             lines.append(f"| {buffer} | {factor} | {bal:.2e} | {share:.3f} | {failed} | "
                          f"{' / '.join(str(int(x)) for x in k)} |")
             print(lines[-1], flush=True)
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    emit(lines, args.out)
     return 0
 
 

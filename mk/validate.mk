@@ -30,13 +30,17 @@
 #   mpirun -n 2 mpipd run blast_paper:graded --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_graded_contained
 # blast_paper_buffer_graded (ac55d26, the full 0.8 mm scene under the graded buffer, notes §18):
 #   mpirun -n 2 mpipd run blast_paper --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_buffer_graded
+# blast_paper_dx1.2_buffer_graded (d15d3f8, dx1.2 with the contained gas under the graded buffer, notes §19):
+#   mpirun -n 2 mpipd run blast_paper:dx1.2 --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_dx1.2_buffer_graded
+# blast_paper_row_sum (cd94582, the full 0.8 mm scene under the row-sum family factor, notes §19):
+#   mpirun -n 2 mpipd run blast_paper --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_row_sum
 # The record of 2026-12-03 (notes §12) was made from report folders for the four copper-only
 #   rows, whose run files were not on the machine: runs/rows/<case> = docs/validation/<case>
-#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them; the record of 2026-12-04 (notes §14) from report folders for all eight earlier rows (runs/rows/<case> = docs/validation/<case> at 19b1ac2) and runs/blast_paper_dx1.2_gas_contact/report; the record of 2026-12-04 (notes §15) the same, with runs/blast_paper_dx1.0/report after runs/rows/blast_paper_contained; the record of 2026-12-04 (notes §16) the same, with runs/blast_paper_kappa/report after runs/blast_paper_dx1.0/report; the record of 2026-12-04 (notes §17) from report folders for all eleven earlier rows (runs/rows/<case> = docs/validation/<case> at db5f253: the machine was new) with runs/blast_paper_graded_contained/report after runs/rows/blast_paper_kappa. The record of 2026-12-05 (notes §18) the same, with runs/blast_paper_buffer_graded/report after runs/blast_paper_graded_contained/report.
+#   as of 8edcf30 (`git archive 8edcf30 docs/validation/<case>`), beside the three new run reports; the record of 2026-12-04 (notes §13) the same, with runs/blast_paper_contained/report beside them; the record of 2026-12-04 (notes §14) from report folders for all eight earlier rows (runs/rows/<case> = docs/validation/<case> at 19b1ac2) and runs/blast_paper_dx1.2_gas_contact/report; the record of 2026-12-04 (notes §15) the same, with runs/blast_paper_dx1.0/report after runs/rows/blast_paper_contained; the record of 2026-12-04 (notes §16) the same, with runs/blast_paper_kappa/report after runs/blast_paper_dx1.0/report; the record of 2026-12-04 (notes §17) from report folders for all eleven earlier rows (runs/rows/<case> = docs/validation/<case> at db5f253: the machine was new) with runs/blast_paper_graded_contained/report after runs/rows/blast_paper_kappa. The record of 2026-12-05 (notes §18) the same, with runs/blast_paper_buffer_graded/report after runs/blast_paper_graded_contained/report. The record of 2026-12-05 (notes §19) the same, with runs/blast_paper_row_sum/report and runs/blast_paper_dx1.2_buffer_graded/report after runs/blast_paper_buffer_graded/report.
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
-    runs/blast_paper_buffer_graded/run.h5 \
+    runs/blast_paper_buffer_graded/run.h5 runs/blast_paper_row_sum/run.h5 runs/blast_paper_dx1.2_buffer_graded/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
