@@ -66,12 +66,14 @@ it, which errs on the safe side.  kappa_i follows the bonds lost around the poin
   its own reference).  Measured (benchmarks/family_factor.py,
   docs/multirate_family_factor.md): a granite block with a planar crack, two crossed
   cracks or a ball with 30 % of its bonds broken keeps the intact block's critical
-  step; balls with 60-95 % broken lose 13-89 % of it, never more than the row sum says.
+  step; balls with 60-95 % broken lose 13-90 % of it, about what the row sum says
+  (at 95 %: 0.10-0.15 of it measured, 0.15 said: an estimate, not a bound; the
+  safety factor covers the rest, a margin of 2.5 at safety 0.5).
 * "shape_tensor": kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) of the
   point's own element (the force state omega P K^-1 xi, P linear in F = N K^-1: the
   element's largest eigenvalue scales with 1 / lambda_min(K)).  It errs on the safe
   side by far (a crack face: 0.68 where the step is unchanged; 95 % of a ball's bonds
-  broken: 0.001 where 0.11-0.17 is measured) and holds most of a fractured specimen
+  broken: 0.001 where 0.10-0.15 is measured) and holds most of a fractured specimen
   in the finer classes.
 
 Both are 1 off the correspondence force (the gas, the bond-spring fallback) and at a
