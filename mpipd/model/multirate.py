@@ -180,7 +180,7 @@ class StepClasses:
         #: family_factor: its reference (1/lambda_min(K^0), or R^0), the factor kept, the
         #: rows to recompute; the row sum's element data (owned and ghosts) and R now
         self.kref = self.kfac = self.stale = None
-        self.elem = self.rnow = self.changed = self.edge = None
+        self.elem = self.rnow = self.changed = self.edge = self.near = None
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -442,10 +442,7 @@ def shape_tensor_factor(cl, corr, halo, first: bool):
     if len(rows):
         e = np.empty(len(rows))
         largest_eigenvalue(corr.Kinv[rows], e)                      # 1 / lambda_min(K)
-        ok = e > 0.0
-        f = np.ones(len(rows))
-        f[ok] = np.sqrt(cl.kref[rows[ok]] / e[ok])
-        cl.kfac[rows] = np.minimum(1.0, f)
+        cl.kfac[rows] = _square_root_ratio(cl.kref[rows], e)
 
 
 def row_sum_factor(cl, corr, halo, first: bool):
@@ -469,9 +466,9 @@ def row_sum_factor(cl, corr, halo, first: bool):
                  cl.kref)
         cl.rnow = cl.kref.copy()
         cl.changed = np.zeros(nl, np.uint8)
-        ghosts = np.zeros(n, np.uint8)                  # owned points with ghost neighbours
-        family_min(fam.offsets, fam.nbr, (np.arange(nl) < n).astype(np.uint8), ghosts)
-        cl.edge = np.flatnonzero(ghosts == 0)
+        cl.near = np.zeros(n, np.uint8)
+        family_min(fam.offsets, fam.nbr, (np.arange(nl) < n).astype(np.uint8), cl.near)
+        cl.edge = np.flatnonzero(cl.near == 0)          # owned points with ghost neighbours
     rows = np.flatnonzero(cl.stale)
     s = corr.spring[:n]
     on = ((s == CORRESPONDENCE) | (s == SPRING_F)).astype(np.uint8)   # K invertible
@@ -480,17 +477,21 @@ def row_sum_factor(cl, corr, halo, first: bool):
     cl.changed[:] = 0
     cl.changed[rows] = 1
     halo.exchange(cl.elem, cl.changed)
-    near = np.empty(n, np.uint8)
-    around(fam.offsets, fam.nbr, cl.changed, rows, cl.edge, n, near)
-    redo = np.flatnonzero(near)
+    around(fam.offsets, fam.nbr, cl.changed, rows, cl.edge, n, cl.near)
+    redo = np.flatnonzero(cl.near)
     if len(redo):
         row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, fam.broken, cl.elem,
                  redo, cl.rnow)
-        r = cl.rnow[redo]
-        f = np.ones(len(redo))
-        ok = r > 0.0
-        f[ok] = np.sqrt(cl.kref[redo[ok]] / r[ok])
-        cl.kfac[redo] = np.minimum(1.0, f)
+        cl.kfac[redo] = _square_root_ratio(cl.kref[redo], cl.rnow[redo])
+
+
+def _square_root_ratio(ref, now) -> np.ndarray:
+    """min(1, sqrt(ref / now)) where now > 0, else 1: a family factor from a stiffness
+    measure at rest and now (both factors of FAMILY_FACTORS)."""
+    f = np.ones(len(now))
+    ok = now > 0.0
+    f[ok] = np.sqrt(ref[ok] / now[ok])
+    return np.minimum(1.0, f)
 
 
 #: the scene's ``family_factor`` (mpipd.input.scene.FAMILY_FACTORS)
