@@ -75,7 +75,8 @@ def spread(sim, kb, buffer):
         return kb
     a = np.full(sim.points.n_local, C.top, np.uint8)
     a[:C.n_owned] = kb
-    return buffered(sim.families, a, C.top, buffer == "graded", np.empty(C.n_owned, np.uint8))
+    return buffered(sim.families, a, C.top, buffer == "graded", C.all_rows,
+                    np.empty(C.n_owned, np.uint8))
 
 
 def main(argv=None) -> int:

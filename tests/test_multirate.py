@@ -535,3 +535,43 @@ def test_the_rows_around_changed_elements_on_a_graph_with_ghosts():
         around(offsets, nbr, flag, changed, edge, n, out)
         want = np.array([flag[a] or np.any(flag[adj[a]]) for a in range(n)], np.uint8)
         np.testing.assert_array_equal(out, want)
+
+
+@pytest.mark.parametrize("buffer", ["full", "graded"])
+def test_classes_retaken_where_they_changed_equal_the_whole_pass(buffer):
+    """StepClasses._spread takes the buffer and kmin again only around the points whose
+    base class, then class, changed: at every coarse boundary of a fracturing
+    granite_ring they equal the whole pass written out here (the buffer's rule over
+    every owned point, kmin and the reweighted rows bond by bond)."""
+    from mpipd.model.multirate import buffered
+    over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=3e-6", "output.every=40",
+            f'time.multirate={{max_ratio=4, safety=0.9, buffer="{buffer}"}}']
+    scene, _ = sc.load("granite_ring", over)
+    sim = Simulation(scene, _team())
+    cl, fam = sim.classes, sim.families
+    n = cl.n_owned
+    changes = []
+    spread = cl._spread
+
+    def checking(halo, before=None):
+        previous = cl.previous.copy()
+        spread(halo, before)
+        if before is None:
+            return
+        want = buffered(fam, cl.kbase, cl.top, cl.graded, np.arange(n), np.empty(n, np.uint8))
+        np.testing.assert_array_equal(cl.klass[:n], want)
+        changed = cl.klass != previous
+        kmin, rows = np.empty(n, np.uint8), []
+        for i in range(n):
+            js = fam.nbr[fam.offsets[i]:fam.offsets[i + 1]]
+            kmin[i] = min(cl.klass[i], cl.klass[js].min(initial=255))
+            if changed[i] or changed[js].any():
+                rows.append(i)
+        np.testing.assert_array_equal(cl.kmin, kmin)
+        np.testing.assert_array_equal(cl.reweighted_rows(), rows)
+        changes.append(int(changed[:n].sum()))
+
+    cl._spread = checking
+    while sim.step_count < scene.time.n_steps:
+        sim.step()
+    assert len(changes) == scene.time.n_steps // 4 and sum(c > 0 for c in changes) > 3

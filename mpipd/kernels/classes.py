@@ -24,10 +24,12 @@ def weight(k, level):
 
 
 @numba.njit(cache=True)
-def family_min(offsets, nbr, a, out):
-    """out[i] = min(a[i], min over i's family of a[j]) for the owned points (every
-    bond, broken or not: a broken pair can still touch through contact)."""
-    for i in range(offsets.shape[0] - 1):
+def family_min(offsets, nbr, a, rows, out):
+    """out[i] = min(a[i], min over i's family of a[j]) for the owned points i in
+    ``rows`` (every bond, broken or not: a broken pair can still touch through
+    contact); out elsewhere is left as it is."""
+    for r in range(rows.shape[0]):
+        i = rows[r]
         m = a[i]
         for b in range(offsets[i], offsets[i + 1]):
             if a[nbr[b]] < m:

@@ -180,8 +180,20 @@ class StepClasses:
         #: family_factor: its reference (1/lambda_min(K^0), or R^0), the factor kept, the
         #: rows to recompute; the row sum's element data (owned and ghosts) and R now
         self.kref = self.kfac = self.stale = None
-        self.elem = self.rnow = self.changed = self.edge = self.near = None
+        self.elem = self.rnow = self.changed = None
+        #: owned rows whose closed family holds a class that changed at the last boundary
+        self.reweighted = np.zeros(0, np.int64)
+        #: do klass and kmin follow from kbase (a spread, or a restore, since)?
+        self.spread = False
         if self.enabled:
+            #: every owned row; the owned points with ghosts in their families (what
+            #: :meth:`around` reads besides the changed families); its output buffer
+            self.all_rows = np.arange(n, dtype=np.int64)
+            inner = np.zeros(n, np.uint8)
+            family_min(families.offsets, families.nbr, (np.arange(nl) < n).astype(np.uint8),
+                       self.all_rows, inner)
+            self.edge = np.flatnonzero(inner == 0)
+            self.near = inner
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
@@ -357,29 +369,46 @@ class StepClasses:
             return False
         n = self.n_owned
         self.previous = self.klass.copy()
+        # the last spread's base classes, if klass and kmin follow from them (not
+        # before the first spread: klass starts at 0, kbase at the top class)
+        before = self.kbase.copy() if self.spread else None
         self.kbase[:n] = self.base_classes(corr, halo, step)
-        self._spread(halo)
+        self._spread(halo, before)
         self.boundaries += 1
         return bool(np.any(self.klass[:n] != self.previous[:n]))
 
     def reweighted_rows(self) -> np.ndarray:
-        """Owned points whose closed family holds a point whose class just changed
-        (ghosts included): the forces there change with the weights."""
-        same = (self.klass == self.previous).astype(np.uint8)
-        out = np.empty(self.n_owned, np.uint8)
-        family_min(self.families.offsets, self.families.nbr, same, out)
-        return np.flatnonzero(out == 0)
+        """Owned points whose closed family holds a point whose class changed at the
+        last boundary (ghosts included): the forces there change with the weights."""
+        return self.reweighted
 
-    def _spread(self, halo):
+    def rows_around(self, flag) -> np.ndarray:
+        """The owned points whose closed family holds a point flagged in ``flag``
+        (owned and ghosts; kernels.classes.around)."""
+        n, fam = self.n_owned, self.families
+        flag = flag.astype(np.uint8)
+        around(fam.offsets, fam.nbr, flag, np.flatnonzero(flag[:n]), self.edge, n, self.near)
+        return np.flatnonzero(self.near)
+
+    def _spread(self, halo, before=None):
         """The buffer and the receivers' levels, from the owned base classes:
         k_i = min over i's family of base_j ("full"), or of min(base_i, base_j + 1)
-        ("graded")."""
+        ("graded"); kmin_i = min over i's closed family of k_j.  With ``before``, the
+        base classes (owned and ghosts) of the last spread, only the points whose
+        closed family holds a changed base class, and then a changed class, are
+        taken again: the same classes as the whole pass, at the cost of the changes."""
         n, fam = self.n_owned, self.families
         halo.exchange(self.kbase)
-        buffered(fam, self.kbase, self.top, self.graded, self.klass[:n])
+        rows = self.all_rows if before is None else self.rows_around(self.kbase != before)
+        buffered(fam, self.kbase, self.top, self.graded, rows, self.klass[:n])
         halo.exchange(self.klass)
-        family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
+        if before is None:
+            family_min(fam.offsets, fam.nbr, self.klass, self.all_rows, self.kmin)
+        else:
+            self.reweighted = self.rows_around(self.klass != self.previous)
+            family_min(fam.offsets, fam.nbr, self.klass, self.reweighted, self.kmin)
         self._recount()
+        self.spread = True
 
     def _recount(self):
         self._rows = {}
@@ -394,8 +423,9 @@ class StepClasses:
         if self.enabled:
             fam = self.families
             halo.exchange(self.klass, self.kbase)
-            family_min(fam.offsets, fam.nbr, self.klass, self.kmin)
+            family_min(fam.offsets, fam.nbr, self.klass, self.all_rows, self.kmin)
             self._recount()
+            self.spread = True
 
     # ---------------------------------------------------------------- figures
     def summary(self, team) -> str:
@@ -466,9 +496,6 @@ def row_sum_factor(cl, corr, halo, first: bool):
                  cl.kref)
         cl.rnow = cl.kref.copy()
         cl.changed = np.zeros(nl, np.uint8)
-        cl.near = np.zeros(n, np.uint8)
-        family_min(fam.offsets, fam.nbr, (np.arange(nl) < n).astype(np.uint8), cl.near)
-        cl.edge = np.flatnonzero(cl.near == 0)          # owned points with ghost neighbours
     rows = np.flatnonzero(cl.stale)
     s = corr.spring[:n]
     on = ((s == CORRESPONDENCE) | (s == SPRING_F)).astype(np.uint8)   # K invertible
@@ -477,8 +504,7 @@ def row_sum_factor(cl, corr, halo, first: bool):
     cl.changed[:] = 0
     cl.changed[rows] = 1
     halo.exchange(cl.elem, cl.changed)
-    around(fam.offsets, fam.nbr, cl.changed, rows, cl.edge, n, cl.near)
-    redo = np.flatnonzero(cl.near)
+    redo = cl.rows_around(cl.changed)
     if len(redo):
         row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, fam.broken, cl.elem,
                  redo, cl.rnow)
@@ -498,16 +524,16 @@ def _square_root_ratio(ref, now) -> np.ndarray:
 FAMILY_FACTORS = {"row_sum": row_sum_factor, "shape_tensor": shape_tensor_factor}
 
 
-def buffered(families, kbase, top: int, graded: bool, out) -> np.ndarray:
-    """out[i] (the owned points) = the class after the buffer from the base classes
-    ``kbase`` of the owned points and ghosts: min over i's family of base_j (full), or
-    min(base_i, min over i's family of base_j + 1) (graded)."""
+def buffered(families, kbase, top: int, graded: bool, rows, out) -> np.ndarray:
+    """out[i] (the owned points i in ``rows``) = the class after the buffer from the
+    base classes ``kbase`` of the owned points and ghosts: min over i's family of
+    base_j (full), or min(base_i, min over i's family of base_j + 1) (graded)."""
     if graded:
         up = np.minimum(kbase.astype(np.int16) + 1, top).astype(np.uint8)
-        family_min(families.offsets, families.nbr, up, out)
-        np.minimum(out, kbase[:len(out)], out=out)
+        family_min(families.offsets, families.nbr, up, rows, out)
+        out[rows] = np.minimum(out[rows], kbase[rows])
     else:
-        family_min(families.offsets, families.nbr, kbase, out)
+        family_min(families.offsets, families.nbr, kbase, rows, out)
     return out
 
 
