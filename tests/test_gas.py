@@ -749,3 +749,26 @@ def test_a_gas_contact_distance_above_one_is_refused():
         sc.load("detonation_tube", ["materials.explosive.contact={ distance = 1.5 }"])
     with pytest.raises(sc.SceneError, match="stiff"):
         sc.load("detonation_tube", ["materials.explosive.contact={ stiff = 1.0 }"])
+
+
+def test_the_skin_changes_how_often_the_gas_is_searched_not_the_answer(team):
+    """The Verlet list with the speed-chosen skin (mpipd.model.gas: AHEAD steps at the
+    fastest watched speed) against a search at every step: the same positions and
+    velocities bit for bit after the detonation has driven the tube, with fewer
+    searches."""
+    over = ["parts.2.shape.radius=0.005", "time.t_end=2e-6"]
+    out = {}
+    for every in (False, True):
+        scene, _ = sc.load("detonation_tube", over)
+        sim = Simulation(scene, team)
+        if every:
+            sim.gas._stale = lambda y: True
+        while sim.step_count < scene.time.n_steps:
+            sim.step()
+        n = sim.points.n_owned
+        out[every] = (sim.u[:n].copy(), sim.v[:n].copy(), sim.gas.searches, sim.gas.skin)
+    assert np.array_equal(out[False][0], out[True][0])
+    assert np.array_equal(out[False][1], out[True][1])
+    assert out[True][2] > 2 * out[False][2]
+    assert out[False][3] > sim.gas.reach * 0.2     # the skin grew with the speed
+    assert np.abs(out[False][1]).max() > 100.0     # the gas and tube moved

@@ -14,12 +14,18 @@ material.
   solid, the gas points whose horizon reaches it.  No total-Lagrangian bond
   touches a gas point, and there are no gas-solid pairs with solids the scene does
   not list.  They are searched with a cell list (mpipd.kernels.search; a cKDTree
-  if the points spread too far for its keys) out to the horizon plus a skin
-  (Verlet list, SKIN x the gas horizon) and searched again (with a new remote
-  plan) only once some gas point or owned acted-on solid, on any rank, has moved
-  more than half the skin since: until then every pair within the horizon is in
-  the list.  The kernels keep only pairs inside the horizon, in gid order, so the
-  result is exactly that of a search every step, on any number of ranks.
+  if the points spread too far for its keys) out to the horizon plus a skin s
+  (a Verlet list) and searched again (with a new remote plan) only once some gas
+  point or owned acted-on solid, on any rank, has moved more than s / 2 since:
+  until then every pair within the horizon is in the list.  The kernels keep only
+  pairs inside the horizon, in gid order, so the result is exactly that of a
+  search every step, on any number of ranks, whatever s is.  s is chosen at each
+  search so that the list lasts AHEAD steps at the fastest watched point's speed
+  then, s = 2 AHEAD |v|max dt, within SKIN and SKIN_MAX x the gas horizon: the
+  gas of a blast moves at km/s, a fixed skin of 0.2 horizons would be searched
+  again every step or two (Verlet 1967, Phys. Rev. 159; Allen & Tildesley,
+  Computer Simulation of Liquids, on neighbour lists: the skin is a cost balance
+  between searching and longer lists).
 * It is the "ul" model family (:class:`mpipd.model.base.Model`): ``update`` moves
   the families, volume, energy and pressure on; ``force_data`` hands the halo the
   force data ``gd`` that ``update`` made; ``gather`` adds the pair forces.
@@ -45,8 +51,11 @@ from ..state import AUX, LOCAL
 from .base import Model
 from .families import _csr_by_row
 
-#: Verlet skin of the gas families, as a fraction of the gas horizon
+#: Verlet skin of the gas families, smallest and largest, as fractions of the gas horizon
 SKIN = 0.2
+SKIN_MAX = 1.0
+#: steps a new list should last at the fastest watched point's speed
+AHEAD = 8
 #: reference coordinate given to remote rows (:meth:`Gas._extend`)
 FAR = 1e30
 
@@ -108,7 +117,8 @@ class Gas(Model):
         self.V_pw = self.V_w.copy()              # the last step's
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
-        self.skin = SKIN * self.reach
+        self.skin = SKIN * self.reach             # the skin of the last search
+        self.dt = scene.time.dt
         self.y_built = None                      # watched points' positions at the last search
         self.searches = 0
         self.search_seconds = 0.0
@@ -205,6 +215,17 @@ class Gas(Model):
             stale = bool(self.team.max(int(stale)))
         return stale
 
+    def _skin(self, v) -> float:
+        """The skin of a new search: 2 AHEAD |v|max dt over the watched points (over
+        all ranks when the staleness is: several ranks with remote solids), within
+        SKIN and SKIN_MAX x the gas horizon."""
+        w = self.watch
+        vmax = float(np.sqrt(np.max(np.einsum("ij,ij->i", v[w], v[w])))) if len(w) else 0.0
+        if self.near is not None:
+            vmax = self.team.max(vmax)
+        return float(np.clip(2.0 * AHEAD * vmax * self.dt, SKIN * self.reach,
+                             SKIN_MAX * self.reach))
+
     def search(self, y, v):
         """Fill y_ext, v_ext from the local ``y``, ``v`` and the remote rows' owners;
         then, if stale (:meth:`_stale`), a new remote plan and current-configuration
@@ -214,6 +235,8 @@ class Gas(Model):
         p = self.points
         nl, n = p.n_local, p.n_owned
         stale = self._stale(y)
+        if stale:
+            self.skin = self._skin(v)
         if stale and self.near is not None:
             self._extend(self.near.plan(y, self.reach + self.skin))
         ye, ve = self.y_ext, self.v_ext
