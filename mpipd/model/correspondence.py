@@ -79,12 +79,21 @@ class MaterialGroup:
             for key, arr in sub.items():
                 self.state[key][pos] = arr
 
-    def check_tension(self, sigma, d, mode) -> int:
+    def check_tension(self, sigma, d, mode, level=0) -> int:
+        """The material's tension failure model on the entries whose class acts at
+        ``level``: the others' stress and rate are those of their last update,
+        checked (and passed) then."""
         t = getattr(self.material, "tension", None)
         if t is None:
             return 0
-        return t.apply(self.idx, sigma, d, mode, self.material.strength_factor(self.state,
-                                                                                "tension"))
+        factor = self.material.strength_factor(self.state, "tension")
+        n = 0
+        for pos in self.by_class[:level + 1]:
+            if pos is None:
+                return t.apply(self.idx, sigma, d, mode, factor)
+            if len(pos):
+                n += t.apply(self.idx[pos], sigma, d, mode, factor[pos] if len(factor) else factor)
+        return n
 
 
 class Correspondence(Model):
@@ -311,8 +320,10 @@ class Correspondence(Model):
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W, k, level)
 
     def check_tension(self, mode: np.ndarray) -> int:
-        """Tension failure model (Eqs. 37–38) of the materials that have one."""
-        return sum(g.check_tension(self.sigma, self.d, mode) for g in self.groups)
+        """Tension failure model (Eqs. 37–38) of the materials that have one, at the
+        points whose state was updated at this step's level."""
+        level = self.classes.level
+        return sum(g.check_tension(self.sigma, self.d, mode, level) for g in self.groups)
 
     def force_data(self, u, ledger=None) -> tuple:
         """Force data of the owned points (returned for the halo).  A point that
