@@ -752,23 +752,44 @@ def test_a_gas_contact_distance_above_one_is_refused():
 
 
 def test_the_skin_changes_how_often_the_gas_is_searched_not_the_answer(team):
-    """The Verlet list with the speed-chosen skin (mpipd.model.gas: AHEAD steps at the
-    fastest watched speed) against a search at every step: the same positions and
-    velocities bit for bit after the detonation has driven the tube, with fewer
-    searches."""
+    """The Verlet list with the tuned skin (mpipd.model.gas.SkinTuner), with the
+    largest skin held, and a search at every step: the same positions and
+    velocities bit for bit after the detonation has driven the tube."""
+    from mpipd.model.gas import SKIN_MAX
     over = ["parts.2.shape.radius=0.005", "time.t_end=2e-6"]
     out = {}
-    for every in (False, True):
+    for how in ("tuned", "largest", "every step"):
         scene, _ = sc.load("detonation_tube", over)
         sim = Simulation(scene, team)
-        if every:
-            sim.gas._stale = lambda y: True
+        g = sim.gas
+        if how == "every step":
+            g._stale = lambda y: True
+        elif how == "largest":
+            g.tuner.next = lambda cost: SKIN_MAX
         while sim.step_count < scene.time.n_steps:
             sim.step()
         n = sim.points.n_owned
-        out[every] = (sim.u[:n].copy(), sim.v[:n].copy(), sim.gas.searches, sim.gas.skin)
-    assert np.array_equal(out[False][0], out[True][0])
-    assert np.array_equal(out[False][1], out[True][1])
-    assert out[True][2] > 2 * out[False][2]
-    assert out[False][3] > sim.gas.reach * 0.2     # the skin grew with the speed
-    assert np.abs(out[False][1]).max() > 100.0     # the gas and tube moved
+        out[how] = (sim.u[:n].copy(), sim.v[:n].copy(), g.searches)
+    for how in ("largest", "every step"):
+        assert np.array_equal(out[how][0], out["tuned"][0])
+        assert np.array_equal(out[how][1], out["tuned"][1])
+    assert out["every step"][2] > 2 * out["largest"][2]
+    assert np.abs(out["tuned"][1]).max() > 100.0   # the gas and tube moved
+
+
+def test_the_skin_tuner_settles_at_the_cheapest_skin():
+    """SkinTuner on a made-up cost per step c(f) = 0.02 / f + f^3 (searches against
+    list length; least at f = 0.35): from SKIN it climbs to the minimum and stays
+    within a step of it; with the least cost beyond SKIN_MAX it stays at SKIN_MAX."""
+    from mpipd.model.gas import SKIN, SKIN_MAX, SKIN_STEP, SkinTuner
+    for cost, best in ((lambda f: 0.02 / f + f ** 3, (0.02 / 3) ** 0.25),
+                       (lambda f: 1.0 / f, SKIN_MAX)):
+        t = SkinTuner()
+        assert t.frac == SKIN
+        seen = []
+        for _ in range(40):
+            seen.append(t.next(cost(t.frac)))
+        tail = np.array(seen[10:])
+        assert np.all(tail >= SKIN) and np.all(tail <= SKIN_MAX)
+        assert np.all(tail <= best * SKIN_STEP ** 2 + 1e-12)
+        assert np.all(tail >= best / SKIN_STEP ** 2 - 1e-12)

@@ -19,13 +19,17 @@ material.
   point or owned acted-on solid, on any rank, has moved more than s / 2 since:
   until then every pair within the horizon is in the list.  The kernels keep only
   pairs inside the horizon, in gid order, so the result is exactly that of a
-  search every step, on any number of ranks, whatever s is.  s is chosen at each
-  search so that the list lasts AHEAD steps at the fastest watched point's speed
-  then, s = 2 AHEAD |v|max dt, within SKIN and SKIN_MAX x the gas horizon: the
-  gas of a blast moves at km/s, a fixed skin of 0.2 horizons would be searched
-  again every step or two (Verlet 1967, Phys. Rev. 159; Allen & Tildesley,
-  Computer Simulation of Liquids, on neighbour lists: the skin is a cost balance
-  between searching and longer lists).
+  search every step, on any number of ranks, whatever s is.  s is a cost balance
+  (Verlet 1967, Phys. Rev. 159; Allen & Tildesley, Computer Simulation of Liquids,
+  on neighbour lists): a larger skin means fewer searches and longer lists.  In a
+  blast the balance moves: the dense gas of the first microseconds has long lists
+  and is searched cheaply, the spread gas of the late run has almost no pairs and
+  moves at km/s, so a fixed skin of 0.2 horizons is searched again at every step.
+  So s follows the measured cost (:class:`SkinTuner`): at each search the time per
+  step of the last list (its search and the gas kernels while it lasted) is
+  compared with the list's before, and s moves on by a factor SKIN_STEP in the
+  same direction if it got cheaper, else turns back, within SKIN and SKIN_MAX
+  horizons.  Only the time changes with s, never the answer.
 * It is the "ul" model family (:class:`mpipd.model.base.Model`): ``update`` moves
   the families, volume, energy and pressure on; ``force_data`` hands the halo the
   force data ``gd`` that ``update`` made; ``gather`` adds the pair forces.
@@ -51,11 +55,11 @@ from ..state import AUX, LOCAL
 from .base import Model
 from .families import _csr_by_row
 
-#: Verlet skin of the gas families, smallest and largest, as fractions of the gas horizon
+#: Verlet skin of the gas families, smallest and largest, as fractions of the gas
+#: horizon, and its factor of change at a search (SkinTuner)
 SKIN = 0.2
 SKIN_MAX = 1.0
-#: steps a new list should last at the fastest watched point's speed
-AHEAD = 8
+SKIN_STEP = 1.25
 #: reference coordinate given to remote rows (:meth:`Gas._extend`)
 FAR = 1e30
 
@@ -118,7 +122,7 @@ class Gas(Model):
         self.offsets = np.zeros(n + 1, np.int64)
         self.nbr = np.zeros(0, np.int32)
         self.skin = SKIN * self.reach             # the skin of the last search
-        self.dt = scene.time.dt
+        self.tuner = SkinTuner()
         self.y_built = None                      # watched points' positions at the last search
         self.searches = 0
         self.search_seconds = 0.0
@@ -215,17 +219,6 @@ class Gas(Model):
             stale = bool(self.team.max(int(stale)))
         return stale
 
-    def _skin(self, v) -> float:
-        """The skin of a new search: 2 AHEAD |v|max dt over the watched points (over
-        all ranks when the staleness is: several ranks with remote solids), within
-        SKIN and SKIN_MAX x the gas horizon."""
-        w = self.watch
-        vmax = float(np.sqrt(np.max(np.einsum("ij,ij->i", v[w], v[w])))) if len(w) else 0.0
-        if self.near is not None:
-            vmax = self.team.max(vmax)
-        return float(np.clip(2.0 * AHEAD * vmax * self.dt, SKIN * self.reach,
-                             SKIN_MAX * self.reach))
-
     def search(self, y, v):
         """Fill y_ext, v_ext from the local ``y``, ``v`` and the remote rows' owners;
         then, if stale (:meth:`_stale`), a new remote plan and current-configuration
@@ -235,8 +228,11 @@ class Gas(Model):
         p = self.points
         nl, n = p.n_local, p.n_owned
         stale = self._stale(y)
-        if stale:
-            self.skin = self._skin(v)
+        if stale and self.searches:
+            cost = self.tuner.cost()
+            if self.near is not None:       # one skin on every rank
+                cost = self.team.max(cost)
+            self.skin = self.tuner.next(cost) * self.reach
         if stale and self.near is not None:
             self._extend(self.near.plan(y, self.reach + self.skin))
         ye, ve = self.y_ext, self.v_ext
@@ -248,7 +244,9 @@ class Gas(Model):
             self.y_built = y[self.watch]
             self.searches += 1
             self._pairs(ye, n)
-        self.search_seconds += time.perf_counter() - t0
+        dt = time.perf_counter() - t0
+        self.search_seconds += dt
+        self.tuner.spent(dt, stale)
 
     def _pairs(self, ye, n):
         """The families at positions ``ye`` (local + remote rows): each owned gas point
@@ -295,11 +293,13 @@ class Gas(Model):
         y = self.y = self.y_ext                 # current positions, kept for gather()
         self.V_pw[:] = self.V_w                 # in place: the State holds these arrays
         self.V_w[:] = self.gd[:, GD_V]
+        t0 = time.perf_counter()
         self.n_singular, wq = gas_update(
             self.gas_idx, y, self.v_ext, self.vol_ext, self.V_w, self.V_pw, self.gd,
             p.horizon, self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
             m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.isgas_ext, self.vr_lit,
             self.gq, m.density, self.c_q, self.c_l, *m.unreacted_eos)
+        self.tuner.step(time.perf_counter() - t0)
         self.viscous_work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
         if len(self.gas_idx):
@@ -316,9 +316,11 @@ class Gas(Model):
         if self.y is None:                      # positions from u (collective)
             self.search(p.x + u, v)
             self.y = self.y_ext
+        t0 = time.perf_counter()
         gas_gather(self.rows, self.y, self.vol_ext, self.V_w, self.V_ratio, self.gd,
                    p.horizon, self.offsets, self.nbr, self.isgas_ext, f, self.x_ext,
                    self.contact_frac, self.contact_k)
+        self.tuner.spent(time.perf_counter() - t0)
 
     def lit_density(self, team) -> dict:
         """Per charge (part name): the largest and the mean density at lighting over
@@ -365,6 +367,48 @@ class Gas(Model):
         out = np.zeros(self.points.n_owned)
         out[self.gas_idx] = self.gd[self.gas_idx, GD_P]
         return out
+
+
+class SkinTuner:
+    """The gas's Verlet skin as a fraction of its horizon, tuned on the measured
+    cost (module docstring): a one-dimensional descent on the time per step of a
+    list's life, its search plus the gas kernels and exchanges while it lasted.
+    Each new list takes a skin SKIN_STEP times larger or smaller than the last,
+    in the direction that made the last change cheaper (within SKIN and SKIN_MAX).
+    The skin changes the time of a run, never its numbers."""
+
+    def __init__(self):
+        self.frac = SKIN
+        self.up = True                          # the direction of the next change
+        self.last = None                        # the last list's cost per step (s)
+        self.seconds = 0.0                      # this list's time so far
+        self.steps = 0                          # and its steps
+
+    def spent(self, seconds: float, search: bool = False):
+        """Book ``seconds`` to this list; a search starts a new list with them."""
+        if search:
+            self.seconds = 0.0
+            self.steps = 0
+        self.seconds += seconds
+
+    def step(self, seconds: float):
+        """A step's gas update took ``seconds``."""
+        self.seconds += seconds
+        self.steps += 1
+
+    def cost(self) -> float:
+        """This list's time per step so far."""
+        return self.seconds / max(self.steps, 1)
+
+    def next(self, cost: float) -> float:
+        """The skin fraction of the next list, given this list's ``cost`` per step
+        (the same on every rank when the ranks search together)."""
+        if self.last is not None and cost > self.last:
+            self.up = not self.up
+        self.last = cost
+        f = self.frac * (SKIN_STEP if self.up else 1.0 / SKIN_STEP)
+        self.frac = min(max(f, SKIN), SKIN_MAX)
+        return self.frac
 
 
 def _near_halo(comm, slabs, p, solids_owned, gas_all) -> NearHalo:
