@@ -81,21 +81,14 @@ def cut(sim, case: str, side: int) -> int:
 
 
 def factors(sim) -> dict:
-    """The smallest factor of each rule over the block's intact correspondence points,
-    and of the row sum taken against the block's largest R^0 at rest instead of the
-    point's own ("row_sum, part max": a variant measured, not adopted,
-    docs/multirate.md)."""
+    """The smallest factor of each rule over the block's intact correspondence points."""
     from mpipd.model.multirate import FAMILY_FACTORS
     cl = sim.classes
     out = {}
     for kind in FAMILY_FACTORS:
         cl.factor_kind = kind
         cl.kfac = None
-        f = cl.family_factor(sim.corr, sim.halo)
-        out[kind] = float(f.min())
-        if kind == "row_sum":
-            part_max = np.minimum(1.0, np.sqrt(cl.kref.max() / np.maximum(cl.rnow, 1e-300)))
-            out["row_sum, part max"] = float(np.where(f < 1.0, part_max, 1.0).min())
+        out[kind] = float(cl.family_factor(sim.corr, sim.halo).min())
     return out
 
 

@@ -107,7 +107,7 @@ class Simulation:
 
         sv = scene.solver
         # step classes (multi-rate; all 0 in a single-rate scene)
-        self.classes = StepClasses(scene, p, self.families)
+        self.classes = StepClasses(scene, p, self.families, team)
         self.classes.register(st)
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
                                    self.mode, self.classes, contact=sv.contact,

@@ -139,8 +139,11 @@ class StepClasses:
 
     name = "multirate"
 
-    def __init__(self, scene, points, families):
+    def __init__(self, scene, points, families, team=None):
+        """``team``: the ranks (the part-wide reference of the \"row_sum_part\" factor)."""
         mr = scene.time.multirate
+        self.team = team
+        self.n_parts = len(scene.parts)
         self.ratio = mr.max_ratio if mr is not None else 1
         self.safety = mr.safety if mr is not None else 1.0
         #: the buffer: a class no coarser than any pushed point's ("full") or at most one
@@ -185,15 +188,11 @@ class StepClasses:
         self.reweighted = np.zeros(0, np.int64)
         #: do klass and kmin follow from kbase (a spread, or a restore, since)?
         self.spread = False
+        #: the owned points with ghosts in their families (what :meth:`rows_around`
+        #: reads besides the changed families) and its output buffer, made at first use
+        self.edge = self.near = None
         if self.enabled:
-            #: every owned row; the owned points with ghosts in their families (what
-            #: :meth:`around` reads besides the changed families); its output buffer
-            self.all_rows = np.arange(n, dtype=np.int64)
-            inner = np.zeros(n, np.uint8)
-            family_min(families.offsets, families.nbr, (np.arange(nl) < n).astype(np.uint8),
-                       self.all_rows, inner)
-            self.edge = np.flatnonzero(inner == 0)
-            self.near = inner
+            self.all_rows = np.arange(n, dtype=np.int64)        # every owned row
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
@@ -386,6 +385,11 @@ class StepClasses:
         """The owned points whose closed family holds a point flagged in ``flag``
         (owned and ghosts; kernels.classes.around)."""
         n, fam = self.n_owned, self.families
+        if self.edge is None:
+            self.near = np.zeros(n, np.uint8)
+            inner = (np.arange(len(self.klass)) < n).astype(np.uint8)
+            family_min(fam.offsets, fam.nbr, inner, np.arange(n, dtype=np.int64), self.near)
+            self.edge = np.flatnonzero(self.near == 0)
         flag = flag.astype(np.uint8)
         around(fam.offsets, fam.nbr, flag, np.flatnonzero(flag[:n]), self.edge, n, self.near)
         return np.flatnonzero(self.near)
@@ -475,11 +479,13 @@ def shape_tensor_factor(cl, corr, halo, first: bool):
         cl.kfac[rows] = _square_root_ratio(cl.kref[rows], e)
 
 
-def row_sum_factor(cl, corr, halo, first: bool):
+def row_sum_factor(cl, corr, halo, first: bool, part_max: bool = False):
     """kappa_i = min(1, sqrt(R_i^0 / R_i)) (module docstring): the elements of the
     stale rows of ``cl`` (StepClasses) again (kernels.classes.element_sums), their
     data to the ghosts, and R again at every owned point whose closed family holds a
-    changed element (kernels.classes.row_sums).  Collective (halo)."""
+    changed element (kernels.classes.row_sums).  ``part_max``: R_i^0 is replaced by
+    the largest R^0 over i's part (all ranks), the "row_sum_part" factor.
+    Collective (halo, and the team for ``part_max``)."""
     p, fam = corr.points, cl.families
     n, nl = p.n_owned, p.n_local
     if first:
@@ -495,6 +501,12 @@ def row_sum_factor(cl, corr, halo, first: bool):
         row_sums(p.x, p.volume, corr.omega_j, fam.offsets, fam.nbr, whole, cl.elem, owned,
                  cl.kref)
         cl.rnow = cl.kref.copy()
+        if part_max:                                    # R^0 of the part's stiffest point
+            top = np.zeros(cl.n_parts)
+            np.maximum.at(top, p.part[:n], cl.kref)
+            if cl.team is not None:
+                top = cl.team.max(top)
+            cl.kref = top[p.part[:n]]
         cl.changed = np.zeros(nl, np.uint8)
     rows = np.flatnonzero(cl.stale)
     s = corr.spring[:n]
@@ -521,7 +533,13 @@ def _square_root_ratio(ref, now) -> np.ndarray:
 
 
 #: the scene's ``family_factor`` (mpipd.input.scene.FAMILY_FACTORS)
-FAMILY_FACTORS = {"row_sum": row_sum_factor, "shape_tensor": shape_tensor_factor}
+def part_row_sum_factor(cl, corr, halo, first: bool):
+    """kappa_i = min(1, sqrt(max over i's part of R^0 / R_i)) (module docstring)."""
+    row_sum_factor(cl, corr, halo, first, part_max=True)
+
+
+FAMILY_FACTORS = {"row_sum": row_sum_factor, "row_sum_part": part_row_sum_factor,
+                  "shape_tensor": shape_tensor_factor}
 
 
 def buffered(families, kbase, top: int, graded: bool, rows, out) -> np.ndarray:
