@@ -330,7 +330,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             f"mpipd.kernels.ul.well_posed): {off} of {n_gas}")
         log(f"mpipd: gas families searched {team.max(sim.gas.searches)} times in this "
             f"invocation, {team.max(sim.gas.search_seconds):.1f} s on the slowest rank "
-            f"(mpipd.model.gas: Verlet skin {sim.gas.skin * 1e3:.3g} mm)")
+            f"(mpipd.model.gas: Verlet skin tuned on the cost, {sim.gas.skin * 1e3:.3g} mm at the last search)")
     if sim.probes is not None:
         for name, (srr, vr, pmax) in sim.probes.peaks().items():
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "

@@ -444,6 +444,14 @@ def test_row_sum_factor_against_the_stiffness_row_sums_built_from_their_definiti
     k = cl.base_classes(corr, sim.halo, step=10_000)            # long after the breakage
     j = int(np.argmin(np.where(ball, got, 2.0)))
     assert k[j] == min(3, int(np.floor(np.log2(r0 * got[j]))))
+    # "row_sum_part": against the bar's largest R^0 at rest (its corners'): the crack
+    # face is no stiffer than they are (factor 1), the crushed ball is
+    cl.factor_kind, cl.kfac = "row_sum_part", None
+    part = cl.family_factor(corr, sim.halo)
+    assert np.allclose(part, np.minimum(1.0, np.sqrt(R0.max() / R)), rtol=1e-9)
+    assert np.all(part[face] == 1.0) and part[ball].min() < 0.9
+    assert np.all(part >= got)
+    cl.factor_kind, cl.kfac = "row_sum", None
     from mpipd.kernels.layout import MODE_TENSION
     corr.mode[j] = MODE_TENSION
     assert cl.family_factor(corr, sim.halo)[j] == 1.0

@@ -69,6 +69,12 @@ it, which errs on the safe side.  kappa_i follows the bonds lost around the poin
   step; balls with 60-95 % broken lose 13-90 % of it, about what the row sum says
   (at 95 %: 0.10-0.15 of it measured, 0.15 said: an estimate, not a bound; the
   safety factor covers the rest, a margin of 2.5 at safety 0.5).
+* "row_sum_part": the same row sum against the largest R^0 of i's part at rest (all
+  ranks): at rest the rule steps the part's stiffest points (edges and corners, cut by
+  the surface) at dt_c, stable to 1.75 dt_c as measured on the block; a crack face no
+  stiffer than they are keeps its step (measured: factor 1 for cracks and 30 % balls,
+  as the critical step; 1.4-2.3x the measured step for balls 80-95 % broken, hence
+  the scene's bound safety <= 0.5, a margin of 1.6 there).
 * "shape_tensor": kappa_i = min(1, sqrt(lambda_min(K_i) / lambda_min(K_i^0))) of the
   point's own element (the force state omega P K^-1 xi, P linear in F = N K^-1: the
   element's largest eigenvalue scales with 1 / lambda_min(K)).  It errs on the safe
@@ -532,12 +538,12 @@ def _square_root_ratio(ref, now) -> np.ndarray:
     return np.minimum(1.0, f)
 
 
-#: the scene's ``family_factor`` (mpipd.input.scene.FAMILY_FACTORS)
 def part_row_sum_factor(cl, corr, halo, first: bool):
     """kappa_i = min(1, sqrt(max over i's part of R^0 / R_i)) (module docstring)."""
     row_sum_factor(cl, corr, halo, first, part_max=True)
 
 
+#: the scene's ``family_factor`` (mpipd.input.scene.FAMILY_FACTORS)
 FAMILY_FACTORS = {"row_sum": row_sum_factor, "row_sum_part": part_row_sum_factor,
                   "shape_tensor": shape_tensor_factor}
 
