@@ -49,7 +49,7 @@ BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, 
 #                                 index, volume factor, fallback toggles, ledger row index,
 #                                 the family's finest step class
 MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
-MULTIRATE_OWNED = 8             # the step of each point's last family change (multi-rate only)
+MULTIRATE_OWNED = 17            # last family change, the row, rows_around's buffer (multi-rate only)
 BYTES_PER_BOND = 21             # nbr (int32) + broken (uint8) + omega_i, omega_j (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy

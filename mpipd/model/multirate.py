@@ -196,9 +196,11 @@ class StepClasses:
         self.spread = False
         #: the owned points with ghosts in their families (what :meth:`rows_around`
         #: reads besides the changed families) and its output buffer, made at first use
-        self.edge = self.near = None
+        self.edge = np.zeros(0, np.int64)
+        self.near = np.zeros(0, np.uint8)
+        #: every owned row (multi-rate only)
+        self.all_rows = np.arange(n if self.enabled else 0, dtype=np.int64)
         if self.enabled:
-            self.all_rows = np.arange(n, dtype=np.int64)        # every owned row
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
@@ -225,6 +227,12 @@ class StepClasses:
         state.add("step_class_min", self.name, self.kmin)
         state.add("step_class_touched", self.name, self.touched, checkpoint=self.enabled)
         state.add("step_class_u", self.name, self.u_then.reshape(-1, 3), rows=AUX)
+        # the rows of the last class change, every owned row, and the slab-edge rows
+        # with their buffer (rebuilt from the classes and families: no checkpoint)
+        state.add("step_class_reweighted", self.name, get=lambda: self.reweighted, rows=AUX)
+        state.add("step_class_rows", self.name, self.all_rows, rows=AUX)
+        state.add("step_class_edge", self.name, get=lambda: self.edge, rows=AUX)
+        state.add("step_class_near", self.name, get=lambda: self.near, rows=AUX)
 
     # ---------------------------------------------------------------- the schedule
     def boundary(self, step: int) -> bool:
@@ -391,7 +399,7 @@ class StepClasses:
         """The owned points whose closed family holds a point flagged in ``flag``
         (owned and ghosts; kernels.classes.around)."""
         n, fam = self.n_owned, self.families
-        if self.edge is None:
+        if len(self.near) != n:
             self.near = np.zeros(n, np.uint8)
             inner = (np.arange(len(self.klass)) < n).astype(np.uint8)
             family_min(fam.offsets, fam.nbr, inner, np.arange(n, dtype=np.int64), self.near)
