@@ -13,7 +13,8 @@ spreads it with each buffer.  Nothing of the run is written.  The variants:
 * the rule (the scene's buffer) and the other buffer;
 * no buffer (every point at its own base class);
 * without the fracture rule (a family that lost bonds in the last coarse steps);
-* the fracture rule at class 1 instead of 0;
+* the fracture rule at class 1 instead of 0, and over 1 coarse step (2 if the scene's
+  window is 1) instead of the scene's ``fracture_window``;
 * the other family factor (row sum or shape tensor), and none.
 """
 from __future__ import annotations
@@ -67,6 +68,17 @@ def other_factor(sim, kind):
         C.factor_kind, C.kfac = scene_kind, None
 
 
+def other_window(sim, window):
+    """base_classes with the fracture rule over ``window`` coarse steps, then the
+    scene's window again."""
+    C = sim.classes
+    scene_window, C.window = C.window, window
+    try:
+        return base_classes(sim)
+    finally:
+        C.window = scene_window
+
+
 def spread(sim, kb, buffer):
     """The classes after the buffer ("full", "graded" or None) on one rank."""
     from mpipd.model.multirate import buffered
@@ -98,15 +110,18 @@ def main(argv=None) -> int:
     other = "full" if mr.buffer == "graded" else "graded"
     fc = mr.fracture_class
     rule = base_classes(sim)
+    window = 2 if C.window == 1 else 1
     kind = "shape_tensor" if mr.family_factor == "row_sum" else "row_sum"
     rows = [
-        (f"the rule (buffer {mr.buffer}, fracture class {fc}, family factor {mr.family_factor})",
+        (f"the rule (buffer {mr.buffer}, fracture class {fc} over {C.window} coarse steps, "
+         f"family factor {mr.family_factor})",
          rule, mr.buffer),
         (f"buffer {other}", rule, other),
         ("no buffer", rule, None),
         ("no fracture rule", base_classes(sim, fracture=False), mr.buffer),
         (f"fracture class {1 if fc == 0 else 0}", base_classes(sim, fracture_class=1 if fc == 0 else 0),
          mr.buffer),
+        (f"fracture window {window} coarse step(s)", other_window(sim, window), mr.buffer),
         (f"family factor {kind}", other_factor(sim, kind), mr.buffer),
         ("no family factor kappa", base_classes(sim, kappa=False), mr.buffer),
     ]

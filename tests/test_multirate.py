@@ -86,6 +86,8 @@ def test_level_schedule():
     ("time.multirate={max_ratio=4}", "output.every", "max_ratio = 4"),     # every = 5
     ('time.multirate={buffer="wide"}', "time.multirate.buffer", '"graded"'),
     ("time.multirate={max_ratio=4, fracture_class=3}", "time.multirate.fracture_class", "0..2"),
+    ("time.multirate={max_ratio=4, fracture_window=-1}", "time.multirate.fracture_window", "0..8"),
+    ("time.multirate={max_ratio=4, fracture_window=9}", "time.multirate.fracture_window", "0..8"),
     ('time.multirate={family_factor="row_sum_part", safety=0.6}', "time.multirate.safety",
      "row_sum_part"),
 ])
@@ -304,16 +306,35 @@ def test_a_thinned_point_takes_a_finer_class_and_one_beyond_dt_is_named():
     assert f"{names[sim.points.material[900]]} 0.500 dt at gid {int(sim.points.gid[900])}" in line
 
 
-def bar_at_rest_ratio(r0, ratio, factor="row_sum"):
-    """The bar with classes from the state (safety 1, family factor ``factor``) and dt
-    set so that every point's ratio at rest is ``r0``."""
+def bar_at_rest_ratio(r0, ratio, factor="row_sum", more=""):
+    """The bar with classes from the state (safety 1, family factor ``factor``, further
+    multirate keys ``more``) and dt set so that every point's ratio at rest is ``r0``."""
     from mpipd.check import stable_dt
     probe = sc.load("elastic_wave", BAR + ["time.dt=1e-8", "time.t_end=1.6e-6"])[0]
     dt = min(stable_dt(probe.parts[0], probe.materials[probe.parts[0].material])) / r0
     scene, _ = sc.load("elastic_wave", BAR + [f"time.dt={dt}", f"time.t_end={80 * dt}",
                                                f"time.multirate={{max_ratio={ratio}, safety=1.0, "
-                                               f'family_factor="{factor}"}}'])
+                                               f'family_factor="{factor}"{more}}}'])
     return Simulation(scene, _team())
+
+
+@pytest.mark.parametrize("window", [0, 1, 2, 3])
+def test_a_fracturing_family_is_fine_for_its_window_of_coarse_steps(window):
+    """fracture_window W (mpipd.model.multirate): a point whose family changed at the
+    coarse boundary s takes at most fracture_class (here 0, where it takes 3 at rest)
+    at the boundaries s, s + 8, ..., s + 8 W of ratio 8, and its class at rest at
+    s + 8 (W + 1); W = 0 is no such rule.  Its neighbours are untouched."""
+    sim = bar_at_rest_ratio(10.0, 8, more=f", fracture_window={window}")
+    cl, corr = sim.classes, sim.corr
+    n = sim.points.n_owned
+    assert np.all(cl.klass[:n] == 3) and cl.window == window
+    s, i = 80, 400
+    cl.step = s
+    cl.touch(np.array([i]))
+    for m in range(window + 3):
+        k = cl.base_classes(corr, sim.halo, step=s + 8 * m)
+        assert k[i] == (0 if m <= window and window > 0 else 3), m
+        assert np.all(np.delete(k, i) == 3)
 
 
 def test_a_refined_point_at_rest_returns_to_its_class_at_rest():

@@ -83,8 +83,9 @@ class Multirate:
     frames and checkpoints happen every ``max_ratio`` steps).  ``buffer``: how a
     point's class follows its family's, "full" (no coarser than any point it pushes)
     or "graded" (at most one class coarser: a step ratio of 2 across any bond);
-    ``fracture_class``: the class a point whose family lost bonds in the last coarse
-    steps takes at most; ``family_factor``: how a point's stable step follows the
+    ``fracture_class``: the class a point whose family lost bonds in the last
+    ``fracture_window`` coarse steps takes at most (a window of 0: no such rule);
+    ``family_factor``: how a point's stable step follows the
     bonds it and its neighbours lost, "row_sum" (the Gershgorin row sum at the point
     against its own at rest), "row_sum_part" (against the largest of its part at rest;
     safety at most PART_SAFETY) or "shape_tensor" (lambda_min of its own K)
@@ -93,6 +94,7 @@ class Multirate:
     safety: float = 0.5
     buffer: str = "graded"
     fracture_class: int = 0
+    fracture_window: int = 2
     family_factor: str = "row_sum"
 
     def check(self, path):
@@ -116,10 +118,15 @@ class Multirate:
         if not 0 <= self.fracture_class <= top:
             fail(join(path, "fracture_class"), f"fracture_class must be a class 0..{top} of "
                  f"max_ratio = {self.max_ratio} (got {self.fracture_class})")
+        if not 0 <= self.fracture_window <= MAX_FRACTURE_WINDOW:
+            fail(join(path, "fracture_window"), f"fracture_window must be a number of coarse "
+                 f"steps 0..{MAX_FRACTURE_WINDOW} (got {self.fracture_window})")
 
 
 #: the coarse/fine step ratios multi-rate integration accepts (verified in make verify)
 MAX_RATIOS = (1, 2, 4, 8)
+#: the longest fracture window (coarse steps) a scene may ask for
+MAX_FRACTURE_WINDOW = 8
 #: how a point's class follows its family's (mpipd.model.multirate.StepClasses._spread)
 BUFFERS = ("full", "graded")
 #: how a point's stable step follows its family (mpipd.model.multirate.FAMILY_FACTORS)

@@ -101,7 +101,8 @@ coarser, a step ratio of 2 across a bond, the 2:1 grading of subcycled and adapt
 meshes: each element still steps within its own stable estimate, the condition of the
 AVI stability analysis (Fong et al. 2008), while the layer beside every fine point no
 longer steps at the finest class (docs/multirate.md).  A point whose family lost bonds
-in the last RECENT coarse steps takes at most ``fracture_class``.  When a class
+in the last ``fracture_window`` coarse steps (the scene's, 2 by default; 0: no such rule) takes
+at most ``fracture_class``.  When a class
 changes, the forces at the boundary are gathered again with the new weights (the
 second half kick of velocity Verlet with a changed step), and the jump of the
 integrator term this makes is booked in the ledger's ``multirate`` entry.
@@ -116,8 +117,6 @@ from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
 HYSTERESIS = 1.25
-#: a point whose family changed (bonds broke) within this many coarse steps is fine
-RECENT = 2
 
 
 def level_at(step: int, ratio: int) -> int:
@@ -157,6 +156,7 @@ class StepClasses:
         self.graded = mr is not None and mr.buffer == "graded"
         self.factor_kind = mr.family_factor if mr is not None else "row_sum"
         self.fracture_class = mr.fracture_class if mr is not None else 0
+        self.window = mr.fracture_window if mr is not None else 0
         self.top = self.ratio.bit_length() - 1
         self.dt = scene.time.dt
         n, nl = points.n_owned, points.n_local
@@ -331,10 +331,10 @@ class StepClasses:
         down = np.clip(down, 0, self.top).astype(np.uint8)
         up = np.clip(up, 0, self.top).astype(np.uint8)
         k = np.minimum(down, np.maximum(self.kbase[:n], up))
-        # fracturing: a family that changed (bonds broke) within the last RECENT coarse
-        # steps takes at most the fracture class (the finest by default)
-        if fracture:
-            recent = step - self.touched <= RECENT * self.ratio
+        # fracturing: a family that changed (bonds broke) within the last fracture_window
+        # coarse steps takes at most the fracture class (the finest by default)
+        if fracture and self.window > 0:
+            recent = step - self.touched <= self.window * self.ratio
             fc = self.fracture_class if fracture_class is None else fracture_class
             k[recent] = np.minimum(k[recent], fc)
         return k
@@ -455,7 +455,8 @@ class StepClasses:
                         for k in range(self.top + 1))
         buffer = "graded" if self.graded else "full"
         return (f"multi-rate (max_ratio {self.ratio}, safety {self.safety:g}, {buffer} buffer, "
-                f"fracture class {self.fracture_class}, family factor {self.factor_kind}): now {cls}; "
+                f"fracture class {self.fracture_class} over {self.window} coarse steps, "
+                f"family factor {self.factor_kind}): now {cls}; "
                 f"bond states evaluated {share:.3f} of single-rate's; classes changed at "
                 f"{self.changes} of {self.boundaries} coarse steps (a change of the forces gathered at each)")
 
