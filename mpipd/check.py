@@ -406,7 +406,8 @@ def class_report(scene, table, bonds, part_dt) -> list[str]:
     bnd = [int(bonds[of_layer == k].sum()) for k in range(top + 1)]
     cost = projected_cost(bnd)
     lines = [f"  multi-rate: max_ratio {mr.max_ratio}, safety {mr.safety:g}, {mr.buffer} buffer, "
-             f"fracture class {mr.fracture_class}, family factor {mr.family_factor}; classes at rest "
+             f"fracture class {mr.fracture_class} over {mr.fracture_window} coarse steps, family "
+             f"factor {mr.family_factor}; classes at rest "
              "(before the one-family buffer next to a finer class and the state's refinement "
              "by compression, smallest stretch, the family left and fracture, which the run applies):"]
     for k in range(top + 1):
