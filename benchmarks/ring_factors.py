@@ -3,10 +3,12 @@ under each buffer and each family factor (docs/multirate.md, The family factor):
 ledger's largest balance at the coarse boundaries, the share of single-rate's bond
 states evaluated, the failed points and the classes at the end.
 
-    python benchmarks/ring_factors.py [--out FILE] [--safety S ...]
+    python benchmarks/ring_factors.py [--out FILE] [--safety S ...] [--windows W ...]
 
 At the test's safety 0.9 by default; ``--safety`` takes one or more others (blast_paper's
-0.5).  One rank, about 1 minute per safety and factor.
+0.5).  ``--windows`` runs the default family factor with each fracture window (coarse
+steps; 0: no fracture rule) instead of each factor at the default window.  One rank,
+seconds per case.
 """
 from __future__ import annotations
 
@@ -27,14 +29,14 @@ OVER = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every
         "solver.refresh_after_break=true"]
 
 
-def run(buffer: str, factor: str, safety: float):
+def run(buffer: str, factor: str, safety: float, window: int = 2):
     from mpi4py import MPI
 
     from mpipd.input import scene as sc
     from mpipd.parallel.team import Team
     from mpipd.solver import Simulation
     over = OVER + [f'time.multirate={{max_ratio=4, safety={safety}, buffer="{buffer}", '
-                   f'family_factor="{factor}"}}']
+                   f'family_factor="{factor}", fracture_window={window}}}']
     scene, _ = sc.load("granite_ring", over)
     sim = Simulation(scene, Team(MPI.COMM_SELF))
     n = sim.points.n_owned
@@ -51,20 +53,26 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", help="also write the table (markdown) here")
     ap.add_argument("--safety", type=float, nargs="+", default=[0.9])
+    ap.add_argument("--windows", type=int, nargs="+", help="fracture windows (default factor)")
     args = ap.parse_args(argv)
-    from mpipd.input.scene import BUFFERS, FAMILY_FACTORS
+    from mpipd.input.scene import BUFFERS, FAMILY_FACTORS, Multirate
     cmd = "python benchmarks/ring_factors.py" + (
-        "" if args.safety == [0.9] else " --safety " + " ".join(f"{s:g}" for s in args.safety))
+        "" if args.safety == [0.9] else " --safety " + " ".join(f"{s:g}" for s in args.safety)) + (
+        " --windows " + " ".join(map(str, args.windows)) if args.windows else "")
+    default = Multirate()
+    cases = ([(default.family_factor, w) for w in args.windows] if args.windows
+             else [(f, default.fracture_window) for f in FAMILY_FACTORS])
     lines = ["granite_ring (3780 points, JH2, tension failure, contact, viscosity), max_ratio 4, "
              f"96 steps (`{cmd}`).", "",
-             "| safety | buffer | family factor | largest ledger balance | bond states evaluated | "
-             "failed points | classes 0 / 1 / 2 at the end |", "|---|---|---|---|---|---|---|"]
+             "| safety | buffer | family factor | fracture window | largest ledger balance | "
+             "bond states evaluated | failed points | classes 0 / 1 / 2 at the end |",
+             "|---|---|---|---|---|---|---|---|"]
     for safety in args.safety:
         for buffer in BUFFERS:
-            for factor in FAMILY_FACTORS:
-                bal, share, failed, k = run(buffer, factor, safety)
-                lines.append(f"| {safety:g} | {buffer} | {factor} | {bal:.2e} | {share:.3f} | "
-                             f"{failed} | {' / '.join(str(int(x)) for x in k)} |")
+            for factor, window in cases:
+                bal, share, failed, k = run(buffer, factor, safety, window)
+                lines.append(f"| {safety:g} | {buffer} | {factor} | {window} | {bal:.2e} | "
+                             f"{share:.3f} | {failed} | {' / '.join(str(int(x)) for x in k)} |")
                 print(lines[-1], flush=True)
     emit(lines, args.out)
     return 0

@@ -45,6 +45,26 @@ multirate-verify: install
 	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4,mr4full,mr4fc1 --stats \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
 
+# the fracture window on blast_demo (docs/multirate.md, The fracture window): single-rate
+# and ratio 4 with fracture_window = 2 (the default), 1 and 0, each at the five dt of
+# multirate-verify, each reported, then docs/multirate_fracture_window.md (about 25
+# minutes on 2 cores)
+FW_SET_sr :=
+FW_SET_mr4 := --set "time.multirate={max_ratio=4, safety=0.5}"
+FW_SET_w1 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_window=1}"
+FW_SET_w0 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_window=0}"
+FW_RUNS := $(foreach g,sr mr4 w1 w0,$(foreach n,$(MR_N),$(g)_$(n)))
+.PHONY: multirate-window
+multirate-window: install
+	for n in $(MR_N); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
+	  $(foreach g,sr mr4 w1 w0,$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo \
+	    --out runs/window/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$n \
+	    $(FW_SET_$(g)) || exit 1;) done
+	for r in $(FW_RUNS); do $(MPIRUN) -n 2 $(PY) -m postprocess report runs/window/$$r/run.h5 --out runs/window/$$r/report > /dev/null || exit 1; done
+	$(PY) benchmarks/multirate_compare.py --out docs/multirate_fracture_window.md --bands sr,mr4,w1,w0 --stats \
+	    --title "blast_demo over five dt: single-rate (sr) and ratio 4 with fracture_window 2 (mr4, the default), 1 (w1) and 0 (w0); \`make multirate-window\`" \
+	    $(foreach r,$(FW_RUNS),$(r)=runs/window/$(r))
+
 # the rock mass on blast_demo (README: The rock mass): the lattice, jitter, Weibull
 # strength and both, over 3 seeds, each reported, then docs/rockmass_blast_demo.md
 # (benchmarks/rockmass_study.py; about 25 minutes on 2 cores)

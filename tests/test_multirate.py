@@ -193,7 +193,9 @@ def test_state_following_classes_and_the_ledger(buffer):
     from the state: the crushed zone takes the fine class, classes change at
     boundaries (booked in the ledger's multirate term) and the ledger closes
     (refresh_after_break on, as in test_ledger's bound for this impact: without
-    it the pre-break force of every breakage is a first-order error of its own)."""
+    it the pre-break force of every breakage is a first-order error of its own).
+    Without the fracture rule (fracture_window = 0) it closes to 3.6e-4 (graded) and
+    1.5e-4 (full) only: benchmarks/ring_factors.py --windows, docs/multirate.md."""
     over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
             f'time.multirate={{max_ratio=4, safety=0.9, buffer="{buffer}"}}',
             "solver.refresh_after_break=true"]
