@@ -45,7 +45,7 @@ multirate-verify: install
 	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4,mr4full,mr4fc1 --stats \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
 
-# the fracture window on blast_demo (docs/multirate.md, The fracture window): single-rate
+# the fracture window on blast_demo (docs/multirate.md, The fracture phase and the fracture window): single-rate
 # and ratio 4 with fracture_window = 2 (the default), 1 and 0, each at the five dt of
 # multirate-verify, each reported, then docs/multirate_fracture_window.md (about 25
 # minutes on 2 cores)

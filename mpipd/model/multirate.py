@@ -101,11 +101,11 @@ coarser, a step ratio of 2 across a bond, the 2:1 grading of subcycled and adapt
 meshes: each element still steps within its own stable estimate, the condition of the
 AVI stability analysis (Fong et al. 2008), while the layer beside every fine point no
 longer steps at the finest class (docs/multirate.md).  A point whose family lost bonds
-in the last ``fracture_window`` coarse steps (the scene's, 2 by default; 0: no such rule) takes
-at most ``fracture_class``.  When a class
-changes, the forces at the boundary are gathered again with the new weights (the
-second half kick of velocity Verlet with a changed step), and the jump of the
-integrator term this makes is booked in the ledger's ``multirate`` entry.
+in the last ``fracture_window`` coarse steps (the scene's, 2 by default; 0: no such
+rule) takes at most ``fracture_class``.  When a class changes, the forces at the
+boundary are gathered again with the new weights (the second half kick of velocity
+Verlet with a changed step), and the jump of the integrator term this makes is booked
+in the ledger's ``multirate`` entry.
 """
 from __future__ import annotations
 
