@@ -50,7 +50,7 @@ BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, 
 #                                 the family's finest step class
 MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
 MULTIRATE_OWNED = 17            # last family change, the row, rows_around's buffer (multi-rate only)
-BYTES_PER_BOND = 21             # nbr (int32) + broken (uint8) + omega_i, omega_j (float64)
+BYTES_PER_BOND = 29             # nbr (int32) + broken (uint8) + omega_i, omega_j, 1/|xi| (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
 VISCOSITY_LOCAL, VISCOSITY_OWNED = 16, 72   # fd columns; dilatation, viscous force (2 steps)

@@ -32,14 +32,15 @@ def lattice(seed, n=5, dx=1.0e-3, m=3.0):
     infl = np.zeros(N, np.int64)            # the quadratic influence function
     wi = np.empty(len(nbr))
     wj = np.empty(len(nbr))
-    nosb.bond_influence(x, horizon, infl, offsets, nbr, wi, wj)
+    rinv = np.empty(len(nbr))
+    nosb.bond_influence(x, horizon, infl, offsets, nbr, wi, wj, rinv)
     u = rng.normal(0.0, 0.02 * dx, x.shape)
     v = rng.normal(0.0, 1.0, x.shape)
     fd = np.zeros((N, FD_WIDTH_VISCOUS))
     fd[:, :9] = rng.normal(0.0, 1.0e9, (N, 9)) / delta ** 5
     fd[:, FD_H] = rng.uniform(0.5, 1.5, N) * 1.0e9 / delta ** 5
     cbb = np.full(N, 18 * 50e9 / (np.pi * delta ** 4))
-    return dict(x=x, u=u, v=v, vol=vol, horizon=horizon, wi=wi, wj=wj, offsets=offsets,
+    return dict(x=x, u=u, v=v, vol=vol, horizon=horizon, wi=wi, wj=wj, rinv=rinv, offsets=offsets,
                 nbr=nbr, fd=fd, cbb=cbb, rng=rng)
 
 
@@ -50,7 +51,7 @@ def gather(L, klass, level, broken=None, contact=False, fd=None):
     kmin = np.zeros(N, np.uint8)
     f = np.empty((N, 3))
     fv = np.empty((N, 3) if fd.shape[1] > 11 else (0, 3))
-    nosb.gather_forces(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+    nosb.gather_forces(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
                        L["offsets"], L["nbr"], broken, fd, L["cbb"], contact, f, fv,
                        klass, kmin, level)
     return f, fv
@@ -88,8 +89,11 @@ def full_setup(seed):
     N = len(L["x"])
     rng = L["rng"]
     fd = L["fd"]
-    fd[rng.random(N) < 0.15, FD_SPRING] = 1.0                   # some on the bond springs
-    on = rng.random(N) < 0.5                                      # viscosity where compressed
+    # some on the bond springs: B, h and the viscosity 0 there (force_data, viscosity_data)
+    spring = rng.random(N) < 0.15
+    fd[spring, :FD_SPRING] = 0.0
+    fd[spring, FD_SPRING] = 1.0
+    on = (rng.random(N) < 0.5) & ~spring                          # viscosity where compressed
     fd[on, FD_VISC_L] = rng.uniform(0.5, 1.5, on.sum()) * 1e3
     fd[on, FD_VISC_Q] = rng.uniform(0.5, 1.5, on.sum()) * 1e3
     # a bond breaks for both its ends: by the pair (i < j), the same draw from each side
@@ -118,7 +122,7 @@ def test_reweight_is_the_difference_of_two_gathers(seed):
     for rows in (np.arange(N), np.sort(rng.choice(N, N // 3, replace=False))):
         g = np.empty((len(rows), 3))
         gv = np.empty((len(rows), 3))
-        nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+        nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
                              L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, rows,
                              old, new, top, g, gv)
         want = (f_new - f_old)[rows]
@@ -129,7 +133,7 @@ def test_reweight_is_the_difference_of_two_gathers(seed):
     # every bond's change of impulse is equal and opposite: sum_i V_i g_i = 0
     g = np.empty((N, 3))
     gv = np.empty((N, 3))
-    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
                          L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
                          old, new, top, g, gv)
     net = (L["vol"][:, None] * g).sum(axis=0)
@@ -142,7 +146,7 @@ def test_unchanged_classes_change_nothing():
     k = L["rng"].integers(0, 3, N).astype(np.uint8)
     g = np.full((N, 3), np.nan)
     gv = np.full((N, 3), np.nan)
-    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"],
+    nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
                          L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
                          k, k.copy(), 2, g, gv)
     assert (g == 0.0).all() and (gv == 0.0).all()

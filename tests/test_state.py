@@ -90,7 +90,8 @@ def test_every_array_is_registered(team, name, over):
     assert not missing, "arrays not registered in the State: " + ", ".join(missing)
     m = sim.memory()
     assert m["point_bytes"] > 0 and m["bond_bytes"] == sim.families.nbr.nbytes \
-        + sim.families.broken.nbytes + sim.corr.omega_i.nbytes + sim.corr.omega_j.nbytes
+        + sim.families.broken.nbytes + sim.corr.omega_i.nbytes + sim.corr.omega_j.nbytes \
+        + sim.corr.rinv.nbytes
     assert sum(m["by_owner"].values()) == m["point_bytes"] + m["bond_bytes"]
 
 

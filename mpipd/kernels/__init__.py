@@ -13,3 +13,11 @@ only arrays and scalars.  One concern per module:
 Python objects in :mod:`mpipd.model.correspondence` and :mod:`mpipd.solver` gather the
 arrays and call these; nothing here knows about MPI or scenes.
 """
+
+#: numba options of the bond loops (:mod:`.nosb`'s deformation gradients and force
+#: gathers): LLVM may fuse a multiply and an add into one fused multiply-add
+#: ("contract" alone: no reassociation, no assumption about NaN or infinity).  The
+#: fusion is decided when the kernel is compiled, so every rank runs the same machine
+#: code on the same operands in the same order and the results stay bit-identical
+#: across decompositions; they differ from unfused code by rounding.
+BOND_LOOP = {"cache": True, "fastmath": {"contract"}}

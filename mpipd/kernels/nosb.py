@@ -38,6 +38,7 @@ import math
 import numba
 import numpy as np
 
+from . import BOND_LOOP
 from .classes import weight
 from .contact import contact_force
 from .influence import influence
@@ -121,27 +122,29 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
 
 
 @numba.njit(cache=True)
-def bond_influence(x, horizon, infl, offsets, nbr, wi, wj):
+def bond_influence(x, horizon, infl, offsets, nbr, wi, wj, rinv):
     """Both ends' influence of every bond b = (i, j) of the reference configuration:
-    wi[b] = omega_i(|xi|) (point i's function and horizon), wj[b] = omega_j(|xi|).
-    They depend on reference positions only, so they are computed once; the hot
-    kernels read them instead of evaluating |xi| and omega each step (the same
-    numbers, so the same results)."""
+    wi[b] = omega_i(|xi|) (point i's function and horizon), wj[b] = omega_j(|xi|),
+    and rinv[b] = 1 / |xi|.  They depend on reference positions only, so they are
+    computed once; the hot kernels read them instead of evaluating |xi| and omega
+    each step (a square root and a division a bond saved where the viscosity and
+    the dilatation rate need the unit bond xi/|xi|)."""
     n = offsets.shape[0] - 1
     for i in range(n):
         for b in range(offsets[i], offsets[i + 1]):
             j = nbr[b]
             r, wi[b] = bond(x, i, j, infl[i], horizon[i])[3:]
             wj[b] = influence(infl[j], horizon[j], r)
+            rinv[b] = 1.0 / r
 
 
-@numba.njit(cache=True)
-def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, F, Fdot, dil,
-                          klass, level):
+@numba.njit(**BOND_LOOP)
+def deformation_gradients(x, u, v, vol, wi, rinv, offsets, nbr, broken, Kinv, spring, F, Fdot,
+                          dil, klass, level):
     """F (Eq. 5) and Fdot (Eq. 13) of every owned point whose step class
     ``klass[i]`` acts at ``level`` (kernels.classes), from u and v (``wi``: the
     bonds' omega_i, :func:`bond_influence`).  If ``dil`` has rows, also
-    dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44)."""
+    dil_i = sum_j omega Ydot . xi/|xi| V_j (gamma phi of Eq. 44; ``rinv``: 1/|xi|)."""
     want_dil = dil.shape[0] > 0
     n = offsets.shape[0] - 1
     N = np.empty((3, 3))
@@ -197,7 +200,7 @@ def deformation_gradients(x, u, v, vol, wi, offsets, nbr, broken, Kinv, spring, 
             m21 += z2 * e1
             m22 += z2 * e2
             if want_dil:
-                acc += (z0 * e0 + z1 * e1 + z2 * e2) / math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+                acc += (z0 * e0 + z1 * e1 + z2 * e2) * rinv[b]
         if want_dil:
             dil[i] = acc
         N[0, 0], N[0, 1], N[0, 2] = n00, n01, n02
@@ -310,16 +313,19 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, kl
     return n_bad, n_tog
 
 
-@numba.njit(cache=True)
-def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv,
-                  klass, kmin, level):
+@numba.njit(**BOND_LOOP)
+def gather_forces(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f,
+                  fv, klass, kmin, level):
     """Internal force density f (N/m^3) of every owned point (see module docstring);
-    ``wi``, ``wj``: the bonds' omega_i and omega_j (:func:`bond_influence`).
+    ``wi``, ``wj``, ``rinv``: the bonds' omega_i, omega_j and 1/|xi| (:func:`bond_influence`).
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
     (Eqs. 42–44, see kernels.viscosity) acts too, from fd[:, FD_VISC_L], fd[:, FD_VISC_Q] and v; its
-    share of f is also written to ``fv`` (for the energy ledger's viscous work).
+    share of f is also written to ``fv`` (for the energy ledger's viscous work).  Its
+    term is evaluated on every bond, without a branch: where neither end is being
+    compressed its coefficients are 0 and so is the term, and a branch that the
+    data decides half the time costs more than the term.
 
     Multi-rate (kernels.classes): each point's state enters with its weight
     2^k_i if its class acts at ``level``, else 0 (so f is the impulse of the
@@ -328,13 +334,13 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, 
     bond's impulses are equal and opposite.  A point whose closed family has
     no class acting (``kmin[i] > level``) gets f = 0.
     """
-    _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv,
+    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f, fv,
             klass, klass, kmin, level, kmin[:0].astype(np.int64), False)
 
 
-@numba.njit(cache=True)
-def gather_reweight(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, rows,
-                    old, new, top, g, gv):
+@numba.njit(**BOND_LOOP)
+def gather_reweight(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact,
+                    rows, old, new, top, g, gv):
     """g[p] (gv[p]: its viscous share) = f_i(classes ``new``) - f_i(classes ``old``) at a
     coarse boundary (``top``: every class acts) for the owned points i = rows[p], in
     one pass over their bonds: a bond's force (:func:`gather_forces`) is linear in
@@ -342,12 +348,12 @@ def gather_reweight(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb
     bond's force with the differences of the weights, and a bond whose two ends
     kept their classes adds exactly 0 and is passed over unread.  The same sums as
     two gathers, up to rounding."""
-    _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, g, gv,
+    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, g, gv,
             new, old, new, top, rows, True)
 
 
-@numba.njit(cache=True)
-def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contact, f, fv,
+@numba.njit(**BOND_LOOP)
+def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f, fv,
             klass, old, kmin, level, rows, diff):
     """Eq. 1 for owned points with the multi-rate weights: every owned point (row i of
     f) if not ``diff``; else the points rows[q] (row q of f) with the weights of
@@ -377,7 +383,6 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
         si = fd[i, FD_SPRING]
         li = fd[i, FD_VISC_L] if visc else 0.0
         qi = fd[i, FD_VISC_Q] if visc else 0.0
-        vi_on = li != 0.0 or qi != 0.0
         fx = fy = fz = 0.0
         gx = gy = gz = 0.0
         # i's own force state, summed over the bonds first: sum_j omega_i (B_i xi +
@@ -414,7 +419,6 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
             y0 = e0 + (u[j, 0] - ui0)
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
-            r = 0.0                     # |xi| only where a term needs it
             if broken[k]:                # in contact, its pair acting now
                 r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                 g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
@@ -424,40 +428,39 @@ def _gather(x, u, v, vol, horizon, wi, wj, offsets, nbr, broken, fd, cbb, contac
                 fy += g * y1 * vj
                 fz += g * y2 * vj
                 continue
+            # both force states without a branch on the weights: a zero weight makes its
+            # term 0, and a bond-spring point's B and h are 0 (force_data); i's own sums
+            # are applied after the loop only if i acts as a correspondence point
             vj = vol[j]
-            tx = ty = tz = 0.0
+            a = wi[k] * vj
+            sx0 += a * e0
+            sx1 += a * e1
+            sx2 += a * e2
+            sy0 += a * y0
+            sy1 += a * y1
+            sy2 += a * y2
             w_i = wi[k] * ri
-            if w_i != 0.0:
-                if si == 0.0:
-                    a = wi[k] * vj
-                    sx0 += a * e0
-                    sx1 += a * e1
-                    sx2 += a * e2
-                    sy0 += a * y0
-                    sy1 += a * y1
-                    sy2 += a * y2
-                else:
-                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    g = _spring(cbb[i], r, y0, y1, y2) * ri
-                    tx, ty, tz = g * y0, g * y1, g * y2
             w_j = wj[k] * rj
-            if w_j != 0.0:
-                if fd[j, FD_SPRING] == 0.0:
-                    tx += w_j * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + fd[j, FD_H] * y0)
-                    ty += w_j * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + fd[j, FD_H] * y1)
-                    tz += w_j * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + fd[j, FD_H] * y2)
-                else:
-                    r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    g = _spring(cbb[j], r, y0, y1, y2) * rj
-                    tx += g * y0
-                    ty += g * y1
-                    tz += g * y2
-            # the viscosity, where either end is being compressed (else its term is 0)
-            if visc and (vi_on or fd[j, FD_VISC_L] != 0.0 or fd[j, FD_VISC_Q] != 0.0):
+            hj = fd[j, FD_H]
+            tx = w_j * (fd[j, 0] * e0 + fd[j, 1] * e1 + fd[j, 2] * e2 + hj * y0)
+            ty = w_j * (fd[j, 3] * e0 + fd[j, 4] * e1 + fd[j, 5] * e2 + hj * y1)
+            tz = w_j * (fd[j, 6] * e0 + fd[j, 7] * e1 + fd[j, 8] * e2 + hj * y2)
+            sj = fd[j, FD_SPRING]
+            if si != 0.0 or sj != 0.0:      # an end on the bond-spring fallback
                 r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+                g = 0.0
+                if si != 0.0 and w_i != 0.0:
+                    g = _spring(cbb[i], r, y0, y1, y2) * ri
+                if sj != 0.0 and w_j != 0.0:
+                    g += _spring(cbb[j], r, y0, y1, y2) * rj
+                tx += g * y0
+                ty += g * y1
+                tz += g * y2
+            # the viscosity (0 unless an end is being compressed; no branch, see above)
+            if visc:
                 c = viscous_bond(w_i, w_j, li, qi, fd[j, FD_VISC_L], fd[j, FD_VISC_Q],
                                  v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2],
-                                 e0, e1, e2, r)
+                                 e0, e1, e2, rinv[k])
                 cv = c * vol[j]
                 gx -= cv * e0
                 gy -= cv * e1

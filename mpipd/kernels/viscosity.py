@@ -41,7 +41,8 @@ def viscosity_data(dil, gamma, J, trK, spring, cl_rho_c, cq_rho, fd):
 
 
 @numba.njit(cache=True, inline="always")
-def viscous_bond(wi, wj, li, qi, lj, qj, dv0, dv1, dv2, e0, e1, e2, r):
-    """Scalar c with T_v,i<xi> - T_v,j<-xi> = c xi (omega weights wi, wj)."""
-    ydn = (dv0 * e0 + dv1 * e1 + dv2 * e2) / r
+def viscous_bond(wi, wj, li, qi, lj, qj, dv0, dv1, dv2, e0, e1, e2, rinv):
+    """Scalar c with T_v,i<xi> - T_v,j<-xi> = c xi (omega weights wi, wj; ``rinv`` = 1/|xi|);
+    0 where both ends' coefficients are 0."""
+    ydn = (dv0 * e0 + dv1 * e1 + dv2 * e2) * rinv
     return wi * (qi - li * ydn) + wj * (qj - lj * ydn)

@@ -121,8 +121,9 @@ class Correspondence(Model):
         # both ends' influence omega(|xi|) of every bond (reference geometry: once)
         self.omega_i = np.empty(len(families.nbr))
         self.omega_j = np.empty(len(families.nbr))
+        self.rinv = np.empty(len(families.nbr))          # 1 / |xi|
         nosb.bond_influence(points.x, points.horizon, points.influence, families.offsets,
-                            families.nbr, self.omega_i, self.omega_j)
+                            families.nbr, self.omega_i, self.omega_j, self.rinv)
         eye = np.broadcast_to(np.eye(3), (n, 3, 3))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
@@ -182,6 +183,7 @@ class Correspondence(Model):
         add("fd", own, self.fd, rows=LOCAL, exchanged=True)
         add("omega_i", own, self.omega_i, rows=BOND)
         add("omega_j", own, self.omega_j, rows=BOND)
+        add("rinv", own, self.rinv, rows=BOND)
         add("cbb", own, self.cbb, rows=LOCAL)
         add("not_tl", own, self.not_tl, rows=AUX)
         if self.viscosity is not None:
@@ -295,7 +297,7 @@ class Correspondence(Model):
 
     def deform(self, u, v):
         p, fam, cl = self.points, self.families, self.classes
-        nosb.deformation_gradients(p.x, u, v, p.volume, self.omega_i, fam.offsets, fam.nbr,
+        nosb.deformation_gradients(p.x, u, v, p.volume, self.omega_i, self.rinv, fam.offsets, fam.nbr,
                                    fam.broken, self.Kinv, self.spring, self.F, self.Fdot,
                                    self.dil, cl.klass, cl.level)
 
@@ -355,7 +357,7 @@ class Correspondence(Model):
         """Internal force density into f, the viscous share also into fv (if any);
         then the ghost-force correction f_i -= P_i g_i where there is one."""
         p, fam, cl = self.points, self.families, self.classes
-        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
+        nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j, self.rinv,
                            fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact, f,
                            fv, cl.klass, cl.kmin, cl.level)
         if self.interface is not None:
@@ -372,7 +374,7 @@ class Correspondence(Model):
         g = np.empty((len(rows), 3))
         gv = np.empty((len(rows), 3) if len(fv) else (0, 3))
         nosb.gather_reweight(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
-                             fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact,
+                             self.rinv, fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact,
                              rows, previous, cl.klass, cl.top, g, gv)
         f[rows] += g
         if len(fv):
