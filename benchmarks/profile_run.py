@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import cProfile
 import pstats
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -74,6 +73,7 @@ def main(argv=None) -> int:
     if bool(args.scene) == bool(args.restart):
         ap.error("give a SCENE or --restart CHECKPOINT")
 
+    from mpipd.output.writer import git_commit, short_commit
     from mpipd.parallel.team import world
     team = world()
     scene, sim, label = build(args, team)
@@ -102,8 +102,7 @@ def main(argv=None) -> int:
         calls = max(t.get(n, (0.0, 0))[1] for t in tables)
         rows.append((sum(ts) / len(ts), max(ts), calls, n))
     rows.sort(reverse=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip() or "unknown"
+    commit = short_commit(git_commit(), 7)       # "-dirty" if the solver's code is not HEAD's
     lines = [f"# Profile: {label}", "",
              f"`mpirun -n {team.size} python benchmarks/profile_run.py "
              f"{'--restart ' + args.restart if args.restart else args.scene} --steps {args.steps}"

@@ -16,10 +16,17 @@ import numba
 
 
 @numba.njit(cache=True, inline="always")
-def contact_force(y0, y1, y2, r, cs, delta):
-    """Factor g such that the force density on i is g * Y * V_j (Y = y_j - y_i)."""
-    ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-    if ly >= r or ly == 0.0 or r >= delta:
+def contact_force(y0, y1, y2, r2, cs, delta):
+    """Factor g such that the force density on i is g * Y * V_j (Y = y_j - y_i; ``r2``
+    = |xi|^2).  A pair no closer than in the reference configuration is told from the
+    squares, before any square root: most broken bonds have opened, and a correctly
+    rounded square root is monotone, so the verdict is the one |Y| >= |xi| gives."""
+    ly2 = y0 * y0 + y1 * y1 + y2 * y2
+    if ly2 >= r2 or ly2 == 0.0:
+        return 0.0
+    ly = math.sqrt(ly2)
+    r = math.sqrt(r2)
+    if ly >= r or r >= delta:
         return 0.0
     w = 1.0 - r / delta
     return cs * w * w * (ly - r) / delta / ly

@@ -420,9 +420,8 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
             y1 = e1 + (u[j, 1] - ui1)
             y2 = e2 + (u[j, 2] - ui2)
             if broken[k]:                # in contact, its pair acting now
-                r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                g = contact_force(y0, y1, y2, r, 0.5 * (cbb[i] + cbb[j]),
-                                  0.5 * (di + horizon[j])) * rc
+                g = contact_force(y0, y1, y2, e0 * e0 + e1 * e1 + e2 * e2,
+                                  0.5 * (cbb[i] + cbb[j]), 0.5 * (di + horizon[j])) * rc
                 vj = vol[j]
                 fx += g * y0 * vj
                 fy += g * y1 * vj
