@@ -27,6 +27,7 @@ def test_memory_model_matches_allocation(team, name, over):
                   + sim.gas.nbr.nbytes)         # the current families: not modelled
     actual = m["point_bytes"] + m["tree_bytes"]
     assert abs(actual - model) <= 0.01 * model + 4096, (actual, model)
-    # the budget: 24 bytes a bond until the bonds' 1/|xi| (8 bytes) bought 19 % of the
-    # paper specimen's step in its fracture phase (README, "Bond loops without branches")
+    # the budget: 24 bytes a bond until the bonds' 1/|xi| (8 bytes) took a square root
+    # and a division out of both bond loops (README, "Bond loops without data-decided
+    # branches")
     assert m["bytes_per_bond"] == BYTES_PER_BOND <= 32
