@@ -23,6 +23,8 @@ reach the same verdict: bond (i, j) and bond (j, i) break on the same step.
 import numba
 import numpy as np
 
+from .index import family, neighbour
+
 
 @numba.njit(cache=True, inline="always")
 def segment_dist2(x, a, b, k):
@@ -55,10 +57,10 @@ def break_bonds(pair_k, pair_i, x, gid, dx, material, offsets, nbr, broken, touc
         k = pair_k[p]
         i = pair_i[p]
         r2 = (0.5 * dx[k]) ** 2
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            j = nbr[b]
+            j = neighbour(nbr, b)
             hit = i == k or j == k
             if not hit and (material[i] == material[k] or material[j] == material[k]):
                 if gid[i] < gid[j]:
@@ -79,8 +81,8 @@ def pd_damage(points, offsets, nbr, broken, vol, phi):
         i = points[p]
         tot = 0.0
         ok = 0.0
-        for b in range(offsets[i], offsets[i + 1]):
-            v = vol[nbr[b]]
+        for b in range(*family(offsets, i)):
+            v = vol[neighbour(nbr, b)]
             tot += v
             if broken[b] == 0:
                 ok += v

@@ -12,7 +12,9 @@ and x * 1.0 == x, so the kernels give the single-rate numbers bit for bit.
 import math
 
 import numba
+import numpy as np
 
+from .index import family, neighbour
 from .layout import CORRESPONDENCE, INTACT
 from .linalg import principal_max_min
 
@@ -24,6 +26,17 @@ def weight(k, level):
 
 
 @numba.njit(cache=True)
+def weights(level):
+    """:func:`weight` of every uint8 class at ``level``, as a table: a bond loop reads
+    the weight of a neighbour's class with one load instead of a shift, a conversion
+    and a compare."""
+    t = np.empty(256)
+    for k in range(256):
+        t[k] = weight(k, level)
+    return t
+
+
+@numba.njit(cache=True)
 def family_min(offsets, nbr, a, rows, out):
     """out[i] = min(a[i], min over i's family of a[j]) for the owned points i in
     ``rows`` (every bond, broken or not: a broken pair can still touch through
@@ -31,9 +44,8 @@ def family_min(offsets, nbr, a, rows, out):
     for r in range(rows.shape[0]):
         i = rows[r]
         m = a[i]
-        for b in range(offsets[i], offsets[i + 1]):
-            if a[nbr[b]] < m:
-                m = a[nbr[b]]
+        for b in range(*family(offsets, i)):
+            m = min(m, a[neighbour(nbr, b)])
         out[i] = m
 
 
@@ -48,15 +60,16 @@ def around(offsets, nbr, flag, changed, edge, n, out):
     for r in range(changed.shape[0]):
         e = changed[r]
         out[e] = 1
-        for b in range(offsets[e], offsets[e + 1]):
-            if nbr[b] < n:
-                out[nbr[b]] = 1
+        for b in range(*family(offsets, e)):
+            j = neighbour(nbr, b)
+            if j < n:
+                out[j] = 1
     for r in range(edge.shape[0]):
         a = edge[r]
         if out[a]:
             continue
-        for b in range(offsets[a], offsets[a + 1]):
-            if flag[nbr[b]]:
+        for b in range(*family(offsets, a)):
+            if flag[neighbour(nbr, b)]:
                 out[a] = 1
                 break
 
@@ -102,10 +115,10 @@ def element_sums(x, vol, wi, offsets, nbr, broken, Kinv, on, rows, E):
             continue
         K = Kinv[i]
         s = c0 = c1 = c2 = 0.0
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            j = nbr[b]
+            j = neighbour(nbr, b)
             e0 = x[j, 0] - x[i, 0]
             e1 = x[j, 1] - x[i, 1]
             e2 = x[j, 2] - x[i, 2]
@@ -144,10 +157,10 @@ def row_sums(x, vol, wj, offsets, nbr, broken, E, rows, R):
     for r in range(rows.shape[0]):
         a = rows[r]
         acc = E[a, 10] * E[a, 9]
-        for b in range(offsets[a], offsets[a + 1]):
+        for b in range(*family(offsets, a)):
             if broken[b]:
                 continue
-            e = nbr[b]
+            e = neighbour(nbr, b)
             se = E[e, 9]
             if se == 0.0:
                 continue

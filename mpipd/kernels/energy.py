@@ -24,6 +24,7 @@ import math
 
 import numba
 
+from .index import family, neighbour
 from .influence import influence
 from .layout import CORRESPONDENCE, NOT_TL
 
@@ -41,8 +42,8 @@ def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg
         ehg = 0.0
         esp = 0.0
         eco = 0.0
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             e0 = x[j, 0] - x[i, 0]
             e1 = x[j, 1] - x[i, 1]
             e2 = x[j, 2] - x[i, 2]

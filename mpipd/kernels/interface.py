@@ -16,6 +16,7 @@ import math
 import numba
 
 from .classes import weight
+from .index import family, neighbour
 from .influence import influence
 from .layout import FD_H, FD_SPRING, KINV_FLAG
 
@@ -31,10 +32,10 @@ def interface_vectors(x, vol, horizon, infl, offsets, nbr, broken, kinv, points,
         di = horizon[i]
         ci = infl[i]
         own = kinv[i, KINV_FLAG] == 0.0
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            j = nbr[b]
+            j = neighbour(nbr, b)
             e0 = x[j, 0] - x[i, 0]
             e1 = x[j, 1] - x[i, 1]
             e2 = x[j, 2] - x[i, 2]
@@ -96,7 +97,7 @@ def retire(idx, active, offsets, nbr, broken, mode):
         hit = mode[i] != 0
         b = offsets[i]
         while not hit and b < offsets[i + 1]:
-            hit = broken[b] != 0 or mode[nbr[b]] != 0
+            hit = broken[b] != 0 or mode[neighbour(nbr, b)] != 0
             b += 1
         if hit:
             active[p] = 0
@@ -110,8 +111,8 @@ def family_reach(horizon, offsets, nbr, idx, out):
     for p in range(idx.shape[0]):
         i = idx[p]
         m = horizon[i]
-        for b in range(offsets[i], offsets[i + 1]):
-            m = max(m, horizon[nbr[b]])
+        for b in range(*family(offsets, i)):
+            m = max(m, horizon[neighbour(nbr, b)])
         out[p] = m
 
 
@@ -121,8 +122,8 @@ def mixed_families(dx, horizon, infl, offsets, nbr, n_owned, out):
     or influence function."""
     for i in range(n_owned):
         hit = 0
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             if dx[j] != dx[i] or horizon[j] != horizon[i] or infl[j] != infl[i]:
                 hit = 1
                 break
@@ -136,6 +137,6 @@ def spread(flag, offsets, nbr, n_owned, out):
         hit = flag[i]
         b = offsets[i]
         while hit == 0 and b < offsets[i + 1]:
-            hit = flag[nbr[b]]
+            hit = flag[neighbour(nbr, b)]
             b += 1
         out[i] = hit

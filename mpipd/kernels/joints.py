@@ -24,6 +24,7 @@ import numba
 import numpy as np
 
 from .hashrng import _mix
+from .index import family, neighbour
 
 
 @numba.njit(cache=True, inline="always")
@@ -47,8 +48,8 @@ def cut_bonds(x, gid, cuts, offsets, nbr, broken, p, n, e1, e2, spacing, radius,
     for i in range(offsets.shape[0] - 1):
         if not cuts[i]:
             continue
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             if broken[b] or not cuts[j]:
                 continue
             a, c = (i, j) if gid[i] < gid[j] else (j, i)

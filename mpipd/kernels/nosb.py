@@ -39,8 +39,9 @@ import numba
 import numpy as np
 
 from . import BOND_LOOP
-from .classes import weight
+from .classes import weights
 from .contact import contact_force
+from .index import family, neighbour
 from .influence import influence
 from .layout import (
     CORRESPONDENCE,
@@ -84,13 +85,14 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
         nb = 0
         di = horizon[i]
         ci = infl[i]
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            e0, e1, e2, r, w = bond(x, i, nbr[b], ci, di)
+            j = neighbour(nbr, b)
+            e0, e1, e2, r, w = bond(x, i, j, ci, di)
             if w == 0.0:
                 continue
-            w *= vol[nbr[b]]
+            w *= vol[j]
             g += w
             k00 += w * e0 * e0
             k01 += w * e0 * e1
@@ -131,8 +133,8 @@ def bond_influence(x, horizon, infl, offsets, nbr, wi, wj, rinv):
     the dilatation rate need the unit bond xi/|xi|)."""
     n = offsets.shape[0] - 1
     for i in range(n):
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             r, wi[b] = bond(x, i, j, infl[i], horizon[i])[3:]
             wj[b] = influence(infl[j], horizon[j], r)
             rinv[b] = 1.0 / r
@@ -164,10 +166,10 @@ def deformation_gradients(x, u, v, vol, wi, rinv, offsets, nbr, broken, Kinv, sp
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
         vi0, vi1, vi2 = v[i, 0], v[i, 1], v[i, 2]
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            j = nbr[b]
+            j = neighbour(nbr, b)
             e0 = x[j, 0] - xi0
             e1 = x[j, 1] - xi1
             e2 = x[j, 2] - xi2
@@ -228,10 +230,10 @@ def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spr
             continue
         di = horizon[i]
         ci = infl[i]
-        for b in range(offsets[i], offsets[i + 1]):
+        for b in range(*family(offsets, i)):
             if broken[b]:
                 continue
-            j = nbr[b]
+            j = neighbour(nbr, b)
             e0 = x[j, 0] - x[i, 0]
             e1 = x[j, 1] - x[i, 1]
             e2 = x[j, 2] - x[i, 2]
@@ -360,6 +362,7 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
     ``klass`` minus those of ``old``."""
     n = rows.shape[0] if diff else offsets.shape[0] - 1
     visc = fd.shape[1] > 11
+    wt = weights(level)
     for q in range(n):
         i = rows[q] if diff else q
         if not diff and kmin[i] > level:
@@ -370,15 +373,11 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
             continue
         ki = klass[i]
         koi = old[i]
-        ri = weight(ki, level)
+        ri = wt[ki]
         if diff:
-            ri -= weight(koi, level)
+            ri -= wt[koi]
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         ui0, ui1, ui2 = u[i, 0], u[i, 1], u[i, 2]
-        b0, b1, b2 = fd[i, 0], fd[i, 1], fd[i, 2]
-        b3, b4, b5 = fd[i, 3], fd[i, 4], fd[i, 5]
-        b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
-        hi = fd[i, FD_H]
         di = horizon[i]
         si = fd[i, FD_SPRING]
         li = fd[i, FD_VISC_L] if visc else 0.0
@@ -389,8 +388,8 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
         # h_i Y) V_j = B_i s_xi + h_i s_Y, with s_xi = sum_j omega_i V_j xi and s_Y the
         # same of Y (its share of Eq. 1 without a 3x3 product per bond)
         sx0 = sx1 = sx2 = sy0 = sy1 = sy2 = 0.0
-        for k in range(offsets[i], offsets[i + 1]):
-            j = nbr[k]
+        for k in range(*family(offsets, i)):
+            j = neighbour(nbr, k)
             kj = klass[j]
             # the bonds that carry no force (no change of force) at this level are
             # passed over before their positions are read
@@ -400,17 +399,17 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
                 if ri == 0.0 and kj == koj:
                     continue
                 if broken[k]:
-                    rc = weight(min(ki, kj), level) - weight(min(koi, koj), level)
+                    rc = wt[min(ki, kj)] - wt[min(koi, koj)]
                     if not contact or rc == 0.0:
                         continue
                 else:
-                    rj = weight(kj, level) - weight(koj, level)
+                    rj = wt[kj] - wt[koj]
             elif broken[k]:
                 if not (contact and min(ki, kj) <= level):
                     continue
-                rc = weight(min(ki, kj), level)
+                rc = wt[min(ki, kj)]
             else:
-                rj = weight(kj, level)
+                rj = wt[kj]
                 if ri == 0.0 and rj == 0.0:
                     continue
             e0 = x[j, 0] - xi0
@@ -467,7 +466,11 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
             fx += tx * vj
             fy += ty * vj
             fz += tz * vj
-        if ri != 0.0 and si == 0.0:
+        if ri != 0.0 and si == 0.0:     # B_i and h_i read only now: fewer values live in the loop
+            b0, b1, b2 = fd[i, 0], fd[i, 1], fd[i, 2]
+            b3, b4, b5 = fd[i, 3], fd[i, 4], fd[i, 5]
+            b6, b7, b8 = fd[i, 6], fd[i, 7], fd[i, 8]
+            hi = fd[i, FD_H]
             fx += ri * (b0 * sx0 + b1 * sx1 + b2 * sx2 + hi * sy0)
             fy += ri * (b3 * sx0 + b4 * sx1 + b5 * sx2 + hi * sy1)
             fz += ri * (b6 * sx0 + b7 * sx1 + b8 * sx2 + hi * sy2)

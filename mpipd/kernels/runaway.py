@@ -16,6 +16,8 @@ speed passes, and so does a rigid rotation slower than one radian a step.
 import numba
 import numpy as np
 
+from .index import family, neighbour
+
 
 @numba.njit(cache=True)
 def first_runaway(offsets, nbr, x, v, gid, dt):
@@ -25,8 +27,8 @@ def first_runaway(offsets, nbr, x, v, gid, dt):
     best = -1
     dt2 = dt * dt
     for i in range(offsets.shape[0] - 1):
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             dv2 = 0.0
             xi2 = 0.0
             for c in range(3):

@@ -73,6 +73,7 @@ import numba
 import numpy as np
 
 from ..materials.jwl import jwl_cold, jwl_sound_speed2, unreacted_pressure, unreacted_sound_speed2
+from .index import family, neighbour
 from .layout import GD_P, GD_V
 from .linalg import det3, inv3
 
@@ -156,8 +157,8 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
         a0, a1, a2 = gd[i, 0], gd[i, 1], gd[i, 2]
         a3, a4, a5 = gd[i, 3], gd[i, 4], gd[i, 5]
         old = a0 != 0.0 or a1 != 0.0 or a2 != 0.0 or a3 != 0.0 or a4 != 0.0 or a5 != 0.0
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             z0 = v[j, 0] - v[i, 0]
             z1 = v[j, 1] - v[i, 1]
             z2 = v[j, 2] - v[i, 2]
@@ -260,8 +261,8 @@ def gas_gather(rows, y, V_ref, V_w, V0_ratio, gd, delta, offsets, nbr, is_gas, f
         di = delta[i] if is_gas[i] else 0.0
         fx = fy = fz = 0.0
         cx = cy = cz = 0.0                      # contact force (N)
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             y0, y1, y2, ly = current_bond(y, i, j)
             if frac > 0.0 and is_gas[i] != is_gas[j] and ly > 0.0:
                 dc, ell = contact_reach(x, V_ref, i, j, frac)
@@ -306,8 +307,8 @@ def gas_contact_energy(gas_idx, y, x, V_ref, offsets, nbr, is_gas, frac, kc):
         return out
     for k in range(gas_idx.shape[0]):
         i = gas_idx[k]
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
+        for b in range(*family(offsets, i)):
+            j = neighbour(nbr, b)
             if is_gas[j]:
                 continue
             ly = current_bond(y, i, j)[3]
