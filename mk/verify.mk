@@ -33,15 +33,23 @@ MR_SET_sr :=
 MR_SET_mr4 := --set "time.multirate={max_ratio=4, safety=0.5}"
 MR_SET_mr4full := --set 'time.multirate={max_ratio=4, safety=0.5, buffer="full"}'
 MR_SET_mr4fc1 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_class=1}"
+# $(call dt_sweep,GROUPS,SETS,FOLDER): blast_demo for each group g of GROUPS (its
+# options in $(SETS_g)) at each dt = 2 us / N of MR_N, into FOLDER/g_N, each reported
+define dt_sweep
+for n in $(MR_N); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
+  $(foreach g,$(1),$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo \
+    --out $(3)/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$n \
+    $($(2)_$(g)) || exit 1;) done
+for r in $(foreach g,$(1),$(foreach n,$(MR_N),$(g)_$(n))); do \
+  $(MPIRUN) -n 2 $(PY) -m postprocess report $(3)/$$r/run.h5 --out $(3)/$$r/report > /dev/null || exit 1; done
+endef
+
 .PHONY: multirate-verify
 verify: multirate-verify
 multirate-verify: install
-	for n in $(MR_N); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
-	  $(foreach g,sr mr4 mr4full mr4fc1,$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo \
-	    --out runs/multirate/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$n \
-	    $(MR_SET_$(g)) || exit 1;) done
+	$(call dt_sweep,sr mr4 mr4full mr4fc1,MR_SET,runs/multirate)
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/multirate/mr2_100 --overwrite --quiet --set "time.multirate={max_ratio=2, safety=0.5}"
-	for r in $(MR_RUNS); do $(MPIRUN) -n 2 $(PY) -m postprocess report runs/multirate/$$r/run.h5 --out runs/multirate/$$r/report > /dev/null || exit 1; done
+	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/multirate/mr2_100/run.h5 --out runs/multirate/mr2_100/report > /dev/null
 	$(PY) benchmarks/multirate_compare.py --out docs/multirate_blast_demo.md --bands sr,mr4,mr4full,mr4fc1 --stats \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
 
@@ -56,11 +64,7 @@ FW_SET_w0 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_window=0}"
 FW_RUNS := $(foreach g,sr mr4 w1 w0,$(foreach n,$(MR_N),$(g)_$(n)))
 .PHONY: multirate-window
 multirate-window: install
-	for n in $(MR_N); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
-	  $(foreach g,sr mr4 w1 w0,$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo \
-	    --out runs/window/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$n \
-	    $(FW_SET_$(g)) || exit 1;) done
-	for r in $(FW_RUNS); do $(MPIRUN) -n 2 $(PY) -m postprocess report runs/window/$$r/run.h5 --out runs/window/$$r/report > /dev/null || exit 1; done
+	$(call dt_sweep,sr mr4 w1 w0,FW_SET,runs/window)
 	$(PY) benchmarks/multirate_compare.py --out docs/multirate_fracture_window.md --bands sr,mr4,w1,w0 --stats \
 	    --title "blast_demo over five dt: single-rate (sr) and ratio 4 with fracture_window 2 (mr4, the default), 1 (w1) and 0 (w0); \`make multirate-window\`" \
 	    $(foreach r,$(FW_RUNS),$(r)=runs/window/$(r))
