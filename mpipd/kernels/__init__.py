@@ -2,6 +2,7 @@
 only arrays and scalars.  One concern per module:
 
 ``linalg``     3x3 helpers (determinant, inverse, products) on small arrays
+``index``      the family ranges and neighbour indices every bond loop reads with
 ``influence``  the influence functions omega (quadratic, constant, inverse) and
                their per-point codes
 ``nosb``       shape tensor K, deformation gradient F and its rate, force data,
