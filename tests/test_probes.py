@@ -77,3 +77,22 @@ def test_builtin_blast_probes_sample_the_rock(name):
         assert all(pr.part == "rock" for pr in s.probes)
         assert any(q.name != "rock" and part_matches("rock", q.name) for q in s.parts) \
             or all(q.name in ("charge", "tube", "rock") for q in s.parts)
+
+
+def test_blast_paper_slab_keeps_every_probe_inside_its_cut():
+    """blast_paper:slab (the integration's test bed, make multirate-slab) is the scene
+    cut to z <= 10 mm and r <= 40 mm: it keeps every probe of the scene that lies in
+    the cut, at the same place, and no other."""
+    base, _ = sc.load("blast_paper")
+    slab, _ = sc.load("blast_paper:slab")
+    rock = slab.parts[2].shape
+    assert (rock.radius, tuple(rock.z)) == (0.040, (0.0, 0.010))
+    assert all(tuple(p.shape.z) == (0.0, 0.010) for p in slab.parts)
+    assert [p.shape.radius for p in slab.parts[:2]] == [p.shape.radius for p in base.parts[:2]]
+
+    def inside(pr):
+        r = float(np.hypot(pr.position[0], pr.position[1]))
+        return rock.inner_radius < r < rock.radius and rock.z[0] < pr.position[2] < rock.z[1]
+    kept = {pr.name: tuple(pr.position) for pr in base.probes if inside(pr)}
+    assert {pr.name: tuple(pr.position) for pr in slab.probes} == kept
+    assert set(kept) == {"wall", "A", "B", "C", "D", "P1", "P2", "P3"}
