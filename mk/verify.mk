@@ -29,7 +29,7 @@ cases: install
 # docs/multirate_blast_demo.md with each group's range over dt (about 25 minutes on 2 cores)
 MR_N := 100 96 104 120 200
 MR_RUNS := $(foreach g,sr mr4 mr4full mr4fc1,$(foreach n,$(MR_N),$(g)_$(n))) mr2_100
-MR_SET_sr :=
+MR_SET_sr := --set "time.multirate={max_ratio=1}"
 MR_SET_mr4 := --set "time.multirate={max_ratio=4, safety=0.5}"
 MR_SET_mr4full := --set 'time.multirate={max_ratio=4, safety=0.5, buffer="full"}'
 MR_SET_mr4fc1 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_class=1}"
@@ -58,7 +58,7 @@ multirate-verify: install
 # and ratio 4 with fracture_window = 2 (the default), 1 and 0, each at the five dt of
 # multirate-verify, each reported, then docs/multirate_fracture_window.md (about 25
 # minutes on 2 cores)
-FW_SET_sr :=
+FW_SET_sr := --set "time.multirate={max_ratio=1}"
 FW_SET_mr4 := --set "time.multirate={max_ratio=4, safety=0.5}"
 FW_SET_w1 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_window=1}"
 FW_SET_w0 := --set "time.multirate={max_ratio=4, safety=0.5, fracture_window=0}"

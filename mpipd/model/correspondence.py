@@ -199,6 +199,10 @@ class Correspondence(Model):
             owner = f"material {mid} ({mat.registry_name})"
             if g is not None:
                 add(f"group{mid}_idx", owner, g.idx, rows=AUX)
+                # its entries of each step class (MaterialGroup.regroup; None: all)
+                for k in range(self.classes.top + 1):
+                    add(f"group{mid}_class{k}", owner, rows=AUX,
+                        get=lambda g=g, k=k: g.by_class[k] if k < len(g.by_class) else None)
             for key, arr in hist.items():
                 add(f"state{mid}/{key}", owner, arr, rows=rows, checkpoint=True,
                     output=STATE_OUTPUTS.get(key))

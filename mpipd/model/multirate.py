@@ -233,6 +233,20 @@ class StepClasses:
         state.add("step_class_rows", self.name, self.all_rows, rows=AUX)
         state.add("step_class_edge", self.name, get=lambda: self.edge, rows=AUX)
         state.add("step_class_near", self.name, get=lambda: self.near, rows=AUX)
+        # the owned rows of each class up to a level (made at first use, per level)
+        for k in range(self.top):
+            state.add(f"step_class_rows{k}", self.name, get=lambda k=k: self._rows.get(k),
+                      rows=AUX)
+        # each point's critical step, P-wave speed at rest and coarsening margin (from
+        # the scene), and the family factor's reference, factor, stale flags and the
+        # row sum's element data and change flags (made at first use, rebuilt after a
+        # restart): None where multi-rate is off
+        for name in ("dtc", "cp0", "hyst", "kref", "kfac", "stale", "rnow"):
+            state.add(f"step_class_{name}", self.name,
+                      get=lambda name=name: getattr(self, name, None))
+        for name in ("elem", "changed"):
+            state.add(f"step_class_{name}", self.name, get=lambda name=name: getattr(self, name),
+                      rows=LOCAL, exchanged=self.enabled)
 
     # ---------------------------------------------------------------- the schedule
     def boundary(self, step: int) -> bool:
