@@ -47,12 +47,14 @@
 #   mpirun -n 2 mpipd run blast_paper:single_rate --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_single_rate
 # blast_paper_index (0951571, the full 0.8 mm scene with the masked indices, bit for bit §22's physics, notes §24):
 #   mpirun -n 2 mpipd run blast_paper --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_index
+# blast_paper_case1 (7d0cd09, Table 3's case 1 at the paper's geometry, notes §27; case<k> the same):
+#   mpirun -n 2 mpipd run blast_paper:case1 --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_case1
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
     runs/blast_paper_buffer_graded/run.h5 runs/blast_paper_row_sum/run.h5 runs/blast_paper_dx1.2_buffer_graded/run.h5 \
     runs/blast_paper_row_sum_part/run.h5 runs/blast_paper_window0/run.h5 runs/blast_paper_kernels/run.h5 \
-    runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 \
+    runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 runs/blast_paper_case1/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
@@ -71,3 +73,19 @@ validate: install
 diagnoses: install
 	$(PY) benchmarks/diagnoses/wave_speed.py --study --mpirun "$(MPIRUN)" \
 	    --out docs/diagnoses/wave_ring_elastic.md
+
+# `make sensitivity`: Table 3's cases (Fig. 22) at the paper's geometry, from the rows of
+# the record: the base scene (SENS_BASE, the default rule's full run) beside every case
+# row docs/validation/blast_paper_case<k>/ that exists, each with its difference from the
+# base, in docs/sensitivity_blast_paper.md (benchmarks/multirate_compare.py reads each
+# row's report.json). A case row is made by its run (about an hour on 2 ranks; the
+# commands are above), its report and `make validate` with it in VALIDATE_RUNS.
+SENS_BASE ?= docs/validation/blast_paper_index
+SENS_ROWS ?= $(sort $(wildcard docs/validation/blast_paper_case[1-6]))
+SENS_OUT ?= docs/sensitivity_blast_paper.md
+.PHONY: sensitivity
+sensitivity: install
+	@test -n "$(strip $(SENS_ROWS))" || { echo "no case row (docs/validation/blast_paper_case<k>/) to set beside the base: run a case and make validate with it first" >&2; exit 2; }
+	$(PY) benchmarks/multirate_compare.py --out $(SENS_OUT) \
+	    --title "Table 3 at the paper's geometry: the base scene (Table 1) and each case run so far; \`make sensitivity\`" \
+	    table1=$(SENS_BASE) $(foreach d,$(SENS_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))

@@ -11,7 +11,8 @@ from mpipd.parallel.halo import Halo
 from mpipd.solver import Simulation
 from mpipd.state import LOCAL, OWNED, State
 
-#: built-in scenes reduced to seconds; together they build every model
+#: built-in scenes reduced to seconds; together they build every model (blast_demo
+#: with step classes: multi-rate's arrays are state too)
 SCENES = [
     ("elastic_wave", ["parts.0.dx=0.004"]),
     ("granite_ring", ["parts.0.dx=0.002"]),
@@ -19,7 +20,8 @@ SCENES = [
     ("blast_demo", ["parts.0.shape.z=[0.0, 0.003]", "parts.1.shape.z=[0.0, 0.003]",
                     "parts.2.shape.z=[0.0, 0.003]", "parts.2.shape.radius=0.012",
                     "time.t_end=4e-7", "probes=[]",
-                    'output.fields=["u","peak_pressure","peak_speed","pressure","damage"]']),
+                    'output.fields=["u","peak_pressure","peak_speed","pressure","damage"]',
+                    "time.multirate={ max_ratio = 4, safety = 0.5 }"]),
 ]
 #: arrays a Simulation holds that are not per-point state: the decomposition's
 #: layer table and slab bounds (a few numbers per z level)

@@ -273,3 +273,31 @@ def test_steps_that_no_invocation_recorded_are_named():
                                             "steps 0–1200 not recorded)")
     assert validation._throughput(segs, 3000).endswith("over the recorded steps; steps "
                                                        "0–1200 not recorded")
+
+
+def test_make_sensitivity_sets_each_case_beside_the_base(tmp_path):
+    """`make sensitivity` from report.json rows alone: each case's value beside the
+    base's with its difference; without a case row, one line and exit status 2."""
+    env = child_env()
+    env["PYTHONPATH"] = str(ROOT)
+    docs = {}
+    for case, n_tension in (("base", 400), ("blast_paper_case3", 300)):
+        doc = report_json(case, {t.key: inside(t) for t in TARGETS})
+        doc["failure_modes"] = {"intact": 1000, "JH2 plastic (D >= 1)": 50,
+                                "JH2 tensile (p < -T)": 0, "tension model (Eq. 38)": n_tension}
+        doc["energy_ledger"] = {"balance": [0.0, -2e-5], "final_J": {}}
+        docs[case] = write_report(tmp_path / case, doc)
+    out = tmp_path / "s.md"
+    make = ["make", "-s", "-o", "install", "sensitivity", f"PY={sys.executable}",
+            f"SENS_BASE={docs['base']}", f"SENS_OUT={out}"]
+    p = subprocess.run(make + [f"SENS_ROWS={docs['blast_paper_case3']}"], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120, env=env)
+    assert p.returncode == 0, p.stderr
+    rows = {r[0]: r[1:] for r in ([c.strip() for c in ln.strip().strip("|").split("|")]
+                                  for ln in out.read_text().splitlines() if ln.startswith("|"))}
+    assert rows["quantity"] == ["table1", "case3"]
+    assert rows["failed: tension model"] == ["400", "300 (-25.0 %)"]      # (300 - 400) / 400
+    p = subprocess.run(make + ["SENS_ROWS="], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120, env=env)
+    lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("make")]
+    assert p.returncode == 2 and len(lines) == 1 and "no case row" in lines[0]
