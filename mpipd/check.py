@@ -49,7 +49,13 @@ BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, 
 #                                 index, volume factor, fallback toggles, ledger row index,
 #                                 the family's finest step class
 MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
-MULTIRATE_OWNED = 17            # last family change, the row, rows_around's buffer (multi-rate only)
+MULTIRATE_OWNED = 66            # last family change, the row, rows_around's buffer, the
+#                                 critical step, P-wave speed and coarsening margin, the
+#                                 family factor's reference, factor and stale flag, each
+#                                 material group's entries per class (multi-rate only; each
+#                                 class's row list, made per level at first use, is not counted)
+MULTIRATE_ROW_SUM_LOCAL = 89    # the row sum's element data (11 floats) and change flag
+MULTIRATE_ROW_SUM_OWNED = 8     # the row sum now
 BYTES_PER_BOND = 29             # nbr (int32) + broken (uint8) + omega_i, omega_j, 1/|xi| (float64)
 FAILURE_LOCAL, FAILURE_OWNED = 33, 9     # done flags + search tree; phi, touched
 DAMPING_OWNED = 16              # damping coefficient, the ledger's damping energy
@@ -96,7 +102,11 @@ def memory_model(scene) -> tuple[int, int]:
     mr = scene.time.multirate
     if mr is not None:
         local += MULTIRATE_LOCAL_PER_CLASS * (mr.max_ratio.bit_length() - 1)
-        owned += MULTIRATE_OWNED if mr.max_ratio > 1 else 0
+        if mr.max_ratio > 1:
+            owned += MULTIRATE_OWNED
+            if mr.family_factor.startswith("row_sum"):
+                local += MULTIRATE_ROW_SUM_LOCAL
+                owned += MULTIRATE_ROW_SUM_OWNED
     return local, owned
 
 
