@@ -89,7 +89,8 @@ def read_report(path: Path) -> dict:
     run, fm = j["run"], j["failure_modes"]
     modes = [fm.get(k, 0) for k in ("intact", "JH2 plastic (D >= 1)", "JH2 tensile (p < -T)",
                                      "tension model (Eq. 38)")]
-    return {"commit": short_commit(run["git_commit"]), "ranks": int(run["run_ranks"]),
+    return {"from_report": True,
+            "commit": short_commit(run["git_commit"]), "ranks": int(run["run_ranks"]),
             "wall": sum(s["wall_s"] for s in run.get("segments", [])), "dt": float(run["dt_s"]),
             "modes": modes, "broken": int(run["bonds_broken"]),
             "balance": float(j["energy_ledger"]["balance"][-1]),
@@ -97,6 +98,16 @@ def read_report(path: Path) -> dict:
             "evaluated": evaluated(run.get("segments", [])),
             "targets": [(t["label"], t.get("unit", ""), t.get("value")) for t in j["targets"]]
             + lattice_rows(j)}
+
+
+def sources(runs: dict) -> str:
+    """Where the run rows come from: run.h5, or a directory's report.json alone."""
+    alone = [label for label, r in runs.items() if r.get("from_report")]
+    if not alone:
+        return "Run rows from run.h5"
+    if len(alone) == len(runs):
+        return "Run rows from each directory's report.json (no run.h5 beside it)"
+    return "Run rows from run.h5, and from report.json alone for " + ", ".join(alone)
 
 
 def pct(v, ref):
@@ -197,7 +208,7 @@ def main(argv=None):
     text = ((args.title + "\n\n" if args.title else "")
             + "Made by `python benchmarks/multirate_compare.py` from the run directories "
             + ", ".join(f"`{item.partition('=')[2]}`" for item in args.runs)
-            + f"; the reference is {list(runs)[0]}.  Run rows from run.h5, then the report's "
+            + f"; the reference is {list(runs)[0]}.  {sources(runs)}, then the report's "
             "targets (postprocess report) where the runs have one; in brackets the "
             "difference from the reference.\n\n"
             + table(runs))

@@ -297,6 +297,7 @@ def test_make_sensitivity_sets_each_case_beside_the_base(tmp_path):
                                   for ln in out.read_text().splitlines() if ln.startswith("|"))}
     assert rows["quantity"] == ["table1", "case3"]
     assert rows["failed: tension model"] == ["400", "300 (-25.0 %)"]      # (300 - 400) / 400
+    assert "Run rows from each directory's report.json" in out.read_text()
     p = subprocess.run(make + ["SENS_ROWS="], cwd=ROOT, capture_output=True, text=True,
                        timeout=120, env=env)
     lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("make")]
