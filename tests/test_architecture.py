@@ -5,18 +5,15 @@ import re
 from pathlib import Path
 
 import pytest
+from test_state import SCENES
 
 from mpipd.input import scene as sc
 from mpipd.solver import Simulation
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "architecture.md"
-#: the reduced blast_demo of tests/test_state.py, with the peaks asked for: every
-#: model of the table exists in it (gas, failure, interface correction, peaks, step
-#: classes)
-OVER = ["parts.0.shape.z=[0.0, 0.003]", "parts.1.shape.z=[0.0, 0.003]",
-        "parts.2.shape.z=[0.0, 0.003]", "parts.2.shape.radius=0.012", "time.t_end=4e-7",
-        "probes=[]", 'output.fields=["u","peak_pressure","peak_speed","damage"]',
-        "time.multirate={ max_ratio = 4, safety = 0.5 }"]
+#: the reduced blast_demo of tests/test_state.py: every model of the table exists in it
+#: (gas, failure, interface correction, peaks, step classes)
+OVER = dict(SCENES)["blast_demo"]
 
 
 def table_rows():

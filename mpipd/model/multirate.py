@@ -200,6 +200,8 @@ class StepClasses:
         self.near = np.zeros(0, np.uint8)
         #: every owned row (multi-rate only)
         self.all_rows = np.arange(n if self.enabled else 0, dtype=np.int64)
+        #: each owned point's critical step, P-wave speed at rest and coarsening margin
+        self.dtc = self.cp0 = self.hyst = None
         if self.enabled:
             from ..check import stable_dt
             dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
@@ -242,8 +244,7 @@ class StepClasses:
         # row sum's element data and change flags (made at first use, rebuilt after a
         # restart): None where multi-rate is off
         for name in ("dtc", "cp0", "hyst", "kref", "kfac", "stale", "rnow"):
-            state.add(f"step_class_{name}", self.name,
-                      get=lambda name=name: getattr(self, name, None))
+            state.add(f"step_class_{name}", self.name, get=lambda name=name: getattr(self, name))
         for name in ("elem", "changed"):
             state.add(f"step_class_{name}", self.name, get=lambda name=name: getattr(self, name),
                       rows=LOCAL, exchanged=self.enabled)
