@@ -44,10 +44,10 @@ from .parallel.decomp import decompose, halo_width, replicated_parts
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
 BYTES_PER_LOCAL_POINT = 212     # x, gid, part, material, volume, horizon, dx, influence, u, v,
 #                                 fd, cbb, mode, step class and base class
-BYTES_PER_OWNED_POINT = 667     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
+BYTES_PER_OWNED_POINT = 683     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
 #                                 index, volume factor, fallback toggles, ledger row index,
-#                                 the family's finest step class
+#                                 the family's finest step class, lambda_min(K) and its stable floor
 MULTIRATE_LOCAL_PER_CLASS = 24  # u at the last update of each coarse class (multi-rate only)
 MULTIRATE_OWNED = 66            # last family change, the row, rows_around's buffer, the
 #                                 critical step, P-wave speed and coarsening margin, the
@@ -130,11 +130,17 @@ def stable_dt(part, material) -> tuple[float, float]:
     return dt_sa, part.dx / material.p_wave_speed
 
 
+def part_critical_dt(scene) -> np.ndarray:
+    """Each part's stable-step estimate min(dt_c, dx / c_p) (:func:`stable_dt`), by part
+    index: the critical step of a bulk point of the part at rest."""
+    return np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
+
+
 def critical_dt(scene) -> float:
     """The stable-step estimate ``mpipd run`` holds dt to (and ``mpipd check`` reports,
     benchmarks.verify_case scales): dt_max = min over parts of min(dt_c, dx / c_p)
-    (:func:`stable_dt`)."""
-    return min(min(stable_dt(q, scene.materials[q.material])) for q in scene.parts)
+    (:func:`part_critical_dt`)."""
+    return float(part_critical_dt(scene).min())
 
 
 def layer_bonds(scene, table) -> np.ndarray:

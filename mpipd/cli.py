@@ -293,12 +293,18 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             f"{checkpointer.written}; continue with `mpipd run --restart {checkpointer.written}`")
         return 0
     n_spring = sim.spring_points()
+    n_floor = team.sum(sim.corr.count_floor())
+    n_switched = team.sum(sim.corr.floor_switches)
     failed = sim.failure_counts()
     broken = sim.bonds_broken()
     rate = sim.n_bonds_global * (n_steps - first) / max(wall, 1e-12)    # this invocation's
     log(f"mpipd: done in {wall:.2f} s" + (f" (steps {first}-{n_steps})" if first else "")
         + f": {rate / 1e6:.2f} M bond-steps/s, "
-        f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}")
+        f"{rate / team.size / 1e6:.2f} M per rank; spring-fallback points: {n_spring}"
+        + (f" ({n_floor} of them with an invertible shape tensor too soft for dt; "
+           f"{n_switched} such switch(es) from the correspondence force in this "
+           "invocation, mpipd.model.correspondence.stable_floor)"
+           if n_floor or n_switched else ""))
     if sim.failure is not None:
         log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))
             + f"; {broken} bonds broken")

@@ -29,6 +29,7 @@ import time as _time
 
 import numpy as np
 
+from .check import part_critical_dt
 from .input.geometry import LayerTable
 from .input.joints import cut_joints
 from .kernels import integrate, runaway
@@ -109,8 +110,9 @@ class Simulation:
         # step classes (multi-rate; all 0 in a single-rate scene)
         self.classes = StepClasses(scene, p, self.families, team)
         self.classes.register(st)
+        dt_ratio = scene.time.dt / part_critical_dt(scene)[p.part[:n]]
         self.corr = Correspondence(p, self.families, scene.materials, names, sv.hourglass,
-                                   self.mode, self.classes, contact=sv.contact,
+                                   self.mode, self.classes, dt_ratio, contact=sv.contact,
                                    viscosity=sv.viscosity, tl=self.tl)
         self.corr.register(st)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())

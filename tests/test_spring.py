@@ -3,6 +3,7 @@ both act as bond-based springs, f = c s Y/|Y| V_j with c = 18 K / (pi delta^4)."
 import math
 
 import numpy as np
+import pytest
 from conftest import make_scene, scene_dict
 
 from mpipd.solver import Simulation
@@ -21,3 +22,74 @@ def test_two_points_act_as_a_spring(team):
     expected = c * stretch * dx ** 3               # force density on the lower point, +z
     np.testing.assert_allclose(sim.f[0], [0, 0, expected], rtol=1e-12)
     np.testing.assert_allclose(sim.f[1], [0, 0, -expected], rtol=1e-12)
+
+
+# -------------------------------------------------- the stable-step test of the fallback
+def _reduced_family(dt_fraction):
+    """An 9^3 granite block whose centre point keeps only its bonds in the plane z = 0
+    and the one to (0, 0, +dx): K stays invertible (det K passes the RCOND test) but its
+    z eigenvalue has lost most of its reference value.  ``dt_fraction``: dt over the
+    critical step the fallback rule compares with (mpipd.check.part_critical_dt)."""
+    from mpipd.check import part_critical_dt
+    dx = 1e-3
+    d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [9 * dx] * 3}, dx=dx)
+    dtc = part_critical_dt(make_scene(d))[0]
+    d["time"]["dt"] = dt_fraction * dtc
+    return d, dx
+
+
+def _centre_and_keep(sim, dx):
+    """The centre point, and the intact-bond mask of its family under the reduction."""
+    x = sim.points.x
+    c = np.argmin(np.linalg.norm(x[:sim.points.n_owned] - 4.5 * dx, axis=1))
+    fam = sim.families
+    b0, b1 = fam.offsets[c], fam.offsets[c + 1]
+    xi = x[fam.nbr[b0:b1]] - x[c]
+    keep = (np.abs(xi[:, 2]) < 1e-9) | (np.linalg.norm(xi - [0, 0, dx], axis=1) < 1e-9)
+    return c, b0, b1, xi, keep
+
+
+def _lambda_min(xi, delta, V):
+    """lambda_min of K = sum_j omega xi (x) xi V_j, omega = (delta - |xi|)^2 (Eq. 4 with
+    the quadratic influence), computed here with numpy's eigvalsh."""
+    r = np.linalg.norm(xi, axis=1)
+    w = np.where(r < delta, (delta - r) ** 2, 0.0) * V
+    return np.linalg.eigvalsh(np.einsum("b,bi,bj->ij", w, xi, xi))[0]
+
+
+def test_a_point_whose_shape_tensor_is_too_soft_for_the_step_takes_the_springs(team):
+    """floor = (dt / dt_c)^2 lambda_min(K^0) (model.correspondence.stable_floor): the
+    reduced family's lambda_min(K) / lambda_min(K^0) = q, computed here; with
+    (dt / dt_c)^2 at 0.9 q the point keeps its correspondence force, at 1.1 q it takes
+    the bond springs — at an invertible K the RCOND test alone would pass (checked)."""
+    from mpipd.kernels.layout import CORRESPONDENCE, SPRING_K
+    from mpipd.model.correspondence import RCOND
+    d, dx = _reduced_family(0.5)
+    sim = Simulation(make_scene(d), team)
+    c, b0, b1, xi, keep = _centre_and_keep(sim, dx)
+    delta, V = sim.points.horizon[c], dx ** 3
+    q = _lambda_min(xi[keep], delta, V) / _lambda_min(xi, delta, V)
+    assert 1e-3 < q < 0.1                                   # a soft, invertible K
+    r = np.linalg.norm(xi[keep], axis=1)
+    w = (delta - r) ** 2 * V
+    K = np.einsum("b,bi,bj->ij", w, xi[keep], xi[keep])
+    assert np.linalg.det(K) > RCOND * (np.trace(K) / 3) ** 3
+    for frac, code in ((0.9, CORRESPONDENCE), (1.1, SPRING_K)):
+        d, _ = _reduced_family(np.sqrt(frac * q))
+        sim = Simulation(make_scene(d), team)
+        assert sim.corr.n_spring == 0                        # at rest: nobody on springs
+        sim.families.broken[b0:b1] = ~keep
+        sim.corr.rebuild_shape(np.array([c]))
+        assert sim.corr.spring[c] == code, frac
+        assert sim.corr.n_spring == (code == SPRING_K)
+
+
+def test_stable_floor_never_exceeds_the_reference_eigenvalue(team):
+    """At dt above the critical step (``--force``) the floor is lambda_min(K^0) itself
+    (min(1, dt / dt_c)): a point at rest stays on its correspondence force."""
+    d, dx = _reduced_family(1.7)
+    sim = Simulation(make_scene(d), team)
+    c, *_, xi, _ = _centre_and_keep(sim, dx)
+    lam0 = _lambda_min(xi, sim.points.horizon[c], dx ** 3)
+    assert sim.corr.floor[c] == pytest.approx(lam0, rel=1e-10)
+    assert sim.corr.n_spring == 0

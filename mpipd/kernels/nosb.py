@@ -30,8 +30,11 @@ omega_j of the same bond always uses point j's function and horizon.
   Point i's own term is summed before its 3x3 product: sum_j omega_i (B_i xi +
   h_i Y) V_j = B_i s_xi + h_i s_Y, s_xi = sum_j omega_i V_j xi, s_Y likewise of Y.
 * Bond-spring fallback (paper §2.1) where K (too few intact bonds) or F
-  (J <= 0) cannot be inverted: that side of the bond acts as a bond-based
-  spring, T = (c_bb / 2) s Y/|Y| with s = |Y|/|xi| - 1 and c_bb = 18 k / (pi delta^4).
+  (J <= 0) cannot be inverted, or where K has lost so much of its smallest
+  eigenvalue that the point's force is stiffer than the step can integrate
+  (mpipd.model.correspondence.stable_floor): that side of the bond acts as a
+  bond-based spring, T = (c_bb / 2) s Y/|Y| with s = |Y|/|xi| - 1 and
+  c_bb = 18 k / (pi delta^4).
 """
 import math
 
@@ -53,7 +56,7 @@ from .layout import (
     SPRING_F,
     SPRING_K,
 )
-from .linalg import det3, inv3, mul3, mul3_bt, voigt_to_mat
+from .linalg import det3, inv3, mul3, mul3_bt, principal_max_min, voigt_to_mat
 from .viscosity import viscous_bond
 
 
@@ -69,12 +72,16 @@ def bond(x, i, j, code, delta):
 
 
 @numba.njit(cache=True)
-def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma, spring,
-                  rcond, points):
-    """K^-1, tr K and gamma = sum_j omega V_j (Eq. 43) for the owned points in ``points``.
+def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma, lam, spring,
+                  rcond, floor, points):
+    """K^-1, tr K, lambda_min(K) (``lam``; 0 where K cannot be inverted) and
+    gamma = sum_j omega V_j (Eq. 43) for the owned points in ``points``.
 
-    A point with fewer than 3 intact bonds, or with det K <= rcond (tr K / 3)^3,
-    is marked ``spring[i] = SPRING_K`` (bond-spring fallback).  Returns how many are.
+    A point is marked ``spring[i] = SPRING_K`` (bond-spring fallback) if it has fewer
+    than 3 intact bonds, if det K <= rcond (tr K / 3)^3 (K cannot be inverted), or if
+    lambda_min(K) < floor[i]: its correspondence force would be stiffer than the
+    step can integrate (``floor``: mpipd.model.correspondence.stable_floor).
+    Returns how many are.
     """
     K = np.empty((3, 3))
     n_spring = 0
@@ -111,7 +118,11 @@ def shape_tensors(x, vol, horizon, infl, offsets, nbr, broken, Kinv, trK, gamma,
         trK[i] = tr
         gamma[i] = g
         d = det3(K)
-        if nb < 3 or not d > rcond * (tr / 3.0) ** 3:
+        lmin = 0.0
+        if nb >= 3 and d > rcond * (tr / 3.0) ** 3:
+            lmin = principal_max_min(k00, k11, k22, k12, k02, k01)[1]
+        lam[i] = lmin
+        if lmin == 0.0 or lmin < floor[i]:
             spring[i] = SPRING_K
             n_spring += 1
             for r_ in range(3):

@@ -39,6 +39,33 @@ from .base import Model
 RCOND = 1e-8
 
 
+def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
+    """The smallest lambda_min(K_i) at which point i keeps its correspondence force,
+
+        floor_i = min(1, dt / dt_c,i)^2 lambda_min(K_i^0),
+
+    from ``lam0`` = lambda_min(K_i^0) over the whole reference family and ``dt_ratio``
+    = dt / dt_c,i, dt the finest step (every step class's) and dt_c,i the critical step
+    of the point's part at rest (mpipd.check.part_critical_dt).
+
+    Point i's force state is omega P K^-1 xi with P linear in F = N K^-1, so the
+    largest eigenvalue of its element's stiffness grows as 1 / lambda_min(K_i), and
+    the stable step of the central difference, 2 / omega_max, shrinks as
+    sqrt(lambda_min(K_i)): dt_i = dt_c,i sqrt(lambda_min(K_i) / lambda_min(K_i^0)) (the
+    "shape_tensor" family factor of mpipd.model.multirate).  A point that lost bonds
+    until dt_i < dt cannot be stepped stably by any class: with a near-singular K
+    (a few bonds left, nearly coplanar) its correspondence force blew up a jittered
+    rock (docs/validation_notes.md §26) although det K passed the RCOND test.  It
+    takes the bond springs instead, the paper's fallback for a family too poor for
+    K (§2.1).  At rest dt_i = dt_c,i >= dt (``mpipd run`` holds dt to the estimate;
+    beyond it, ``--force``, the floor is lambda_min(K^0) itself), so no point starts on
+    the springs by this rule.  The estimate errs on the safe side (multirate's
+    measurements: a point with 95 % of its bonds broken has 0.001 of dt_c by it,
+    0.10-0.15 measured)."""
+    r = np.minimum(np.asarray(dt_ratio, float), 1.0)
+    return r * r * np.maximum(lam0, 0.0)
+
+
 class MaterialGroup:
     """The owned points of one material and that material's history arrays
     (compact: entry k belongs to point idx[k])."""
@@ -100,11 +127,12 @@ class Correspondence(Model):
     name = "correspondence"
 
     def __init__(self, points, families, materials: dict, material_names, hourglass: float,
-                 mode, classes, contact: bool = False, viscosity=None, tl=None):
+                 mode, classes, dt_ratio, contact: bool = False, viscosity=None, tl=None):
         """``mode``: the State's failure flags (the materials and the tension model
         set them; failed points carry no stress).  ``classes``: the step classes
         (mpipd.model.multirate.StepClasses; its ``level`` says which points' states
-        the next update and gather evaluate)."""
+        the next update and gather evaluate).  ``dt_ratio``: dt over each owned
+        point's critical step at rest (:func:`stable_floor`)."""
         n, nl = points.n_owned, points.n_local
         self.points = points
         self.classes = classes
@@ -160,6 +188,14 @@ class Correspondence(Model):
         self.n_spring = 0
         # points outside the total-Lagrangian model (the gas): code NOT_TL, never counted
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
+        #: the smallest lambda_min(K) of each owned point on the correspondence force
+        self.lam = np.zeros(n)                  # lambda_min(K) now, 0 if K is singular
+        lam0 = np.zeros(n)
+        self.reference_kinv(lam0)
+        self.floor = stable_floor(lam0, dt_ratio)
+        #: owned points this invocation moved from the correspondence force to the
+        #: springs by the stable-step test alone (the run log's figure)
+        self.floor_switches = 0
 
     def register(self, state):
         """This model's arrays in the State (owner "correspondence"), each solid
@@ -168,7 +204,8 @@ class Correspondence(Model):
         computed from them."""
         own, mode = self.name, self.mode
         add = state.add
-        for name in ("Kinv", "trK", "Fdot", "J", "toggled", "gamma", "dil", "hg_modulus"):
+        for name in ("Kinv", "trK", "Fdot", "J", "toggled", "gamma", "dil", "hg_modulus", "lam",
+                     "floor"):
             add(name, own, getattr(self, name))
         # with step classes a point keeps its last rate and volume between its updates:
         # the tension check (every step) and the ledger read them, so a restart needs them
@@ -226,8 +263,10 @@ class Correspondence(Model):
         self.interface = correction
 
     def after_restore(self, halo=None):
-        """Shape tensors from the restored bonds (restart step 2)."""
+        """Shape tensors from the restored bonds (restart step 2); the points the
+        stable-step test puts on the springs there were on them at the checkpoint."""
         self.rebuild_shape()
+        self.floor_switches = 0
 
     # ---------------------------------------------------------------- steps
     def rebuild_shape(self, which: np.ndarray | None = None, u=None) -> int:
@@ -253,8 +292,12 @@ class Correspondence(Model):
             which = np.arange(p.n_owned, dtype=np.int64)
         before = self.spring[which] == CORRESPONDENCE
         nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
-                           fam.broken, self.Kinv, self.trK, self.gamma, self.spring, RCOND, which)
+                           fam.broken, self.Kinv, self.trK, self.gamma, self.lam, self.spring,
+                           RCOND, self.floor, which)
         self.spring[self.not_tl] = NOT_TL
+        # switched by the stable-step test alone (K invertible, below the floor)
+        self.floor_switches += int(np.count_nonzero(
+            before & (self.spring[which] == SPRING_K) & (self.lam[which] > 0.0)))
         if u is not None and len(which):
             Fn = np.empty((len(which), 3, 3))
             cl = self.classes
@@ -277,21 +320,28 @@ class Correspondence(Model):
         self.n_spring = self.count_spring()
         return self.n_spring
 
-    def reference_kinv(self) -> np.ndarray:
+    def reference_kinv(self, lam: np.ndarray | None = None) -> np.ndarray:
         """K^-1 (Eq. 4) of every owned point over its whole reference family (no bond
-        broken; zero where K cannot be inverted), without touching the model's state."""
+        broken; zero where K cannot be inverted), without touching the model's state;
+        lambda_min of that K into ``lam``, if given."""
         p, fam = self.points, self.families
         n = p.n_owned
         Kinv = np.zeros((n, 3, 3))
         spring = np.zeros(n, np.uint8)
         nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
-                           np.zeros_like(fam.broken), Kinv, np.zeros(n), np.zeros(n), spring,
-                           RCOND, np.arange(n, dtype=np.int64))
+                           np.zeros_like(fam.broken), Kinv, np.zeros(n), np.zeros(n),
+                           np.zeros(n) if lam is None else lam, spring, RCOND, np.zeros(n),
+                           np.arange(n, dtype=np.int64))
         return Kinv
 
     def count_spring(self) -> int:
         """Owned total-Lagrangian points on the bond-spring fallback."""
         return int(np.count_nonzero((self.spring == SPRING_K) | (self.spring == SPRING_F)))
+
+    def count_floor(self) -> int:
+        """Owned points on the bond-spring fallback by the stable-step test alone (K
+        invertible, lambda_min(K) below the floor: :func:`stable_floor`)."""
+        return int(np.count_nonzero((self.spring == SPRING_K) & (self.lam > 0.0)))
 
     def update(self, u, v, dt: float, t: float):
         """F and Fdot, then rotation, stretch and d, then the materials' stress."""

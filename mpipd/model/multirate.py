@@ -203,10 +203,9 @@ class StepClasses:
         #: each owned point's critical step, P-wave speed at rest and coarsening margin
         self.dtc = self.cp0 = self.hyst = None
         if self.enabled:
-            from ..check import stable_dt
-            dtc = np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
+            from ..check import part_critical_dt
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
-            self.dtc = dtc[points.part[:n]]
+            self.dtc = part_critical_dt(scene)[points.part[:n]]
             self.cp0 = cp[points.part[:n]]
             self.hyst = coarsening_margin(self.safety * self.dtc / self.dt, self.top)
 
