@@ -9,10 +9,10 @@ import pytest
 from conftest import run_cli
 
 # the rock cut to r = 16 mm: probe C (25.2 mm) moves inside it (a probe beyond a
-# horizon from the body is refused)
-SMALL = ["--set", "time.t_end=7e-6", "--set", "parts.2.shape.radius=0.016",
+# horizon from the body is refused); steps and frames on coarse steps (multiples of 4)
+SMALL = ["--set", "time.t_end=7.2e-6", "--set", "parts.2.shape.radius=0.016",
          "--set", "probes.3.position=[0.0150, 0.0, 0.003]",
-         "--set", "output.every=50"] + [a for k in range(3) for a in
+         "--set", "output.every=60"] + [a for k in range(3) for a in
                                          ("--set", f"parts.{k}.shape.z=[0.0, 0.004]")]
 
 

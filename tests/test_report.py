@@ -961,7 +961,7 @@ def demo_scene():
 def demo_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("demo") / "demo"
     res = run_cli(["run", demo_scene(), "--out", str(out), "--quiet",
-                   "--set", "time.t_end=3.8e-6", "--set", "output.every=38"], ranks=2)
+                   "--set", "time.t_end=4.0e-6", "--set", "output.every=40"], ranks=2)
     assert res.returncode == 0, res.stderr
     return out / "run.h5"
 
