@@ -116,6 +116,7 @@ class Simulation:
                                    viscosity=sv.viscosity, tl=self.tl)
         self.corr.register(st)
         self.n_spring_global = team.sum(self.corr.rebuild_shape())
+        self.corr.floor_switches = 0            # the start's fallback points are no switches
         # the ghost-force correction exists only where dx or the horizon changes
         tl_parts = [q for k, q in enumerate(scene.parts) if k not in gas_parts]
         self.interface = (InterfaceCorrection(p, self.families, self.halo, self.corr, self.tl,
