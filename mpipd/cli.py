@@ -248,8 +248,9 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         n_soft = team.sum(sim.corr.count_floor())
         log(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
             "(shape tensor not invertible" + (f", or, {n_soft} of them, invertible but too soft "
-                                              "for dt: bonds broken at the start, e.g. joints; "
-                                              "mpipd.model.correspondence.stable_floor"
+                                              "for dt (on a restart: switched before the "
+                                              "checkpoint); mpipd.model.correspondence."
+                                              "stable_floor"
                                               if n_soft else "") + ")")
     for note in (sim.probes.notes if sim.probes is not None else ()):
         log(f"mpipd: warning: {note}")

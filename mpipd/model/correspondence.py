@@ -44,7 +44,8 @@ def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
 
         floor_i = min(1, dt / dt_c,i)^2 lambda_min(K_i^0),
 
-    from ``lam0`` = lambda_min(K_i^0) over the whole reference family and ``dt_ratio``
+    from ``lam0`` = lambda_min(K_i^0) over the point's family at the start of the run
+    (its reference family less the bonds that start broken: joints) and ``dt_ratio``
     = dt / dt_c,i, dt the finest step (every step class's) and dt_c,i the critical step
     of the point's part at rest (mpipd.check.part_critical_dt).
 
@@ -57,20 +58,20 @@ def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
     (a few bonds left, nearly coplanar) its correspondence force blew up a jittered
     rock (docs/validation_notes.md §26) although det K passed the RCOND test.  It
     takes the bond springs instead, the paper's fallback for a family too poor for
-    K (§2.1).  A point with its whole family at rest has dt_i = dt_c,i >= dt (``mpipd
-    run`` holds dt to the estimate; beyond it, ``--force``, the floor is
-    lambda_min(K^0) itself), so it does not start on the springs by this rule; a point
-    whose bonds start broken (joints) may.  The reference is the point's own family,
-    so a joint's or a crack's face counts as softer than the same face on the part's
-    free surface, which is stable at dt_c: at dt near dt_c the rule is conservative
-    there (the fragment bench's cubes cut by joints, at 0.55 dt_c: 1728 of 97,336
-    points on the springs at the start; the built-in scenes, at 0.09-0.33 dt_c and
-    without joints, have none).  The estimate errs on the safe side (multirate's
-    measurements: a point with 95 % of its bonds broken has 0.001 of dt_c by it,
-    0.10-0.15 measured); but in such a ball (tests/test_multirate.py, _crushed_block)
-    the points it takes off are the unstable ones: held at 4 dt, the ball's energy grew
-    1.6e5-fold in 800 steps without the rule and stays within 1e-7 with it (84 points
-    on the springs; docs/validation_notes.md §28)."""
+    K (§2.1).  A point with its family at rest has dt_i = dt_c,i >= dt (``mpipd run``
+    holds dt to the estimate; beyond it, ``--force``, the floor is lambda_min(K^0)
+    itself), so no point starts on the springs by this rule.  The reference is the
+    family at the start, not the whole reference family: a face a joint cuts is then
+    treated as the part's free surface is (stable at dt_c, though its K is as soft);
+    with the whole family as reference the fragment bench's cubes cut by joints, at
+    0.55 dt_c, started with 1728 of 97,336 points (the 8 around each joint crossing) on
+    the springs (docs/validation_notes.md §31).  A crack's face, formed in the run, is
+    still measured against the intact family.  The estimate errs on the safe side
+    (multirate's measurements: a point with 95 % of its bonds broken has 0.001 of dt_c
+    by it, 0.10-0.15 measured); but in such a ball (tests/test_multirate.py,
+    _crushed_block) the points it takes off are the unstable ones: held at 4 dt, the
+    ball's energy grew 1.6e5-fold in 800 steps without the rule and stays within 1e-7
+    with it (84 points on the springs; docs/validation_notes.md §28)."""
     r = np.minimum(np.asarray(dt_ratio, float), 1.0)
     return r * r * np.maximum(lam0, 0.0)
 
@@ -199,7 +200,7 @@ class Correspondence(Model):
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)
         self.lam = np.zeros(n)                  # lambda_min(K) now, 0 if K is singular
         lam0 = np.zeros(n)
-        self.reference_kinv(lam0)
+        self.reference_kinv(lam0, families.broken)         # the start: joints cut
         #: the smallest lambda_min(K) of each owned point on the correspondence force
         self.floor = stable_floor(lam0, dt_ratio)
         #: owned points this invocation moved from the correspondence force to the
@@ -329,18 +330,20 @@ class Correspondence(Model):
         self.n_spring = self.count_spring()
         return self.n_spring
 
-    def reference_kinv(self, lam: np.ndarray | None = None) -> np.ndarray:
+    def reference_kinv(self, lam: np.ndarray | None = None,
+                       broken: np.ndarray | None = None) -> np.ndarray:
         """K^-1 (Eq. 4) of every owned point over its whole reference family (no bond
-        broken; zero where K cannot be inverted), without touching the model's state;
-        lambda_min of that K into ``lam``, if given."""
+        broken; or, given ``broken``, less those bonds), zero where K cannot be
+        inverted, without touching the model's state; lambda_min of that K into
+        ``lam``, if given."""
         p, fam = self.points, self.families
         n = p.n_owned
         Kinv = np.zeros((n, 3, 3))
         spring = np.zeros(n, np.uint8)
         nosb.shape_tensors(p.x, p.volume, p.horizon, p.influence, fam.offsets, fam.nbr,
-                           np.zeros_like(fam.broken), Kinv, np.zeros(n), np.zeros(n),
-                           np.zeros(n) if lam is None else lam, spring, RCOND, np.zeros(n),
-                           np.arange(n, dtype=np.int64))
+                           np.zeros_like(fam.broken) if broken is None else broken, Kinv,
+                           np.zeros(n), np.zeros(n), np.zeros(n) if lam is None else lam,
+                           spring, RCOND, np.zeros(n), np.arange(n, dtype=np.int64))
         return Kinv
 
     def count_spring(self) -> int:
