@@ -8,7 +8,8 @@ for a run folder or run file the report is made first, by
 run file.  Rank 0 then writes
 
 * ``<out>.md`` (``--out docs/validation`` writes ``docs/validation.md``): the
-  command that made it; each run's provenance; one table with a row per target of
+  command that made it; each run's provenance; the named cases of the rows' scenes
+  and the rows that ran each (:mod:`postprocess.case_coverage`); one table with a row per target of
   :data:`postprocess.targets.TARGETS` — the paper's and the experiment's value and,
   per run, its value and verdict; a section per run with its key figures; the
   lattice-bias table of the reports that have one; the ``--notes`` text verbatim
@@ -36,6 +37,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .analysis import target_bounds
+from .case_coverage import coverage_table
 from .targets import BY_KEY, TARGETS, verdict
 
 MAX_WIDTH = 900
@@ -428,7 +430,8 @@ def render(runs, command, code_commit, notes) -> str:
          "re-creates it from the run files in `VALIDATE_RUNS` (mk/validate.mk).  Every number "
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
-    L += provenance(runs) + targets_table(runs) + threshold_table(runs) + bias_table(runs)
+    L += (provenance(runs) + coverage_table(runs) + targets_table(runs) + threshold_table(runs)
+          + bias_table(runs))
     for k, r in enumerate(runs, 1):
         L += run_section(k, r)
     L += ["## Diagnoses", ""]

@@ -302,3 +302,39 @@ def test_make_sensitivity_sets_each_case_beside_the_base(tmp_path):
                        timeout=120, env=env)
     lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("make")]
     assert p.returncode == 2 and len(lines) == 1 and "no case row" in lines[0]
+
+
+def test_named_cases_list_the_rows_that_ran_them(tmp_path, capsys):
+    """The record's "Named cases" section (postprocess.case_coverage): each case of the
+    rows' scene with the rows whose report.json names it, the time each reached
+    against the case's t_end (read here from the scene file), and what it set beyond
+    the case's own overrides; a case counts only from a row at its own settings that
+    reached t_end."""
+    import tomllib
+    scenes = ROOT / "mpipd" / "input" / "scenes"
+    t_end = tomllib.loads((scenes / "blast_demo.toml").read_text())["time"]["t_end"] * 1e6
+    sets = tomllib.loads((scenes / "cases" / "blast_demo.toml").read_text())
+    rows = {"base": ("blast_demo", ["output.every=100"], t_end),
+            "c1": ("blast_demo-case1", [*sets["case1"]["set"], 'scene.name="blast_demo-case1"'],
+                   t_end),
+            "c5": ("blast_demo-case5", [*sets["case5"]["set"], 'scene.name="blast_demo-case5"',
+                                        "parts.2.dx=1.2e-3"], 0.5 * t_end)}
+    dirs = []
+    for case, (scene, overrides, reached) in rows.items():
+        doc = report_json(case, {t.key: inside(t) for t in TARGETS})
+        doc["model"].update(scene=scene, overrides=overrides)
+        doc["t_end_us"] = reached
+        dirs.append(str(write_report(tmp_path / case / "report", doc)))
+    assert main(["validate", "--out", str(tmp_path / "v" / "validation"), *dirs]) == 0
+    md = (tmp_path / "v" / "validation.md").read_text()
+    got = {r[0]: r[3] for r in table(md, "### blast_demo")[2:]}
+    assert set(got) == {"(the scene)", *sets}
+    end = f"{t_end:.4g}"
+    assert got["(the scene)"] == f"base ({end} of {end} µs, 0123456)"
+    assert got["case1"] == f"c1 ({end} of {end} µs, 0123456)"
+    assert got["case5"] == (f"c5 ({0.5 * t_end:.4g} of {end} µs: **stopped early**, 0123456; "
+                            "also `parts.2.dx=1.2e-3`)")
+    assert got["case2"] == "not run in this record"
+    left = [c for c in sets if c != "case1"]
+    assert (f"blast_demo: 2 of {len(sets) + 1} (the scene and its {len(sets)} cases) have a "
+            "row at their own settings that reached t_end; not: " + ", ".join(left) + ".") in md
