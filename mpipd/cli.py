@@ -244,9 +244,10 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     if scene.time.dt > dt_stable:
         log(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
             f"{dt_stable:.4e} s (--force); the run may blow up")
-    if sim.n_spring_global:
+    n_spring = sim.spring_points()            # after the restore, on a restart
+    if n_spring:
         n_soft = team.sum(sim.corr.count_floor())
-        log(f"mpipd: {sim.n_spring_global} point(s) use the bond-spring fallback "
+        log(f"mpipd: {n_spring} point(s) use the bond-spring fallback "
             "(shape tensor not invertible" + (f", or, {n_soft} of them, invertible but too soft "
                                               "for dt (on a restart: switched before the "
                                               "checkpoint); mpipd.model.correspondence."

@@ -304,37 +304,72 @@ def test_make_sensitivity_sets_each_case_beside_the_base(tmp_path):
     assert p.returncode == 2 and len(lines) == 1 and "no case row" in lines[0]
 
 
-def test_named_cases_list_the_rows_that_ran_them(tmp_path, capsys):
+def test_named_cases_list_the_rows_that_ran_them(tmp_path, capsys, monkeypatch):
     """The record's "Named cases" section (postprocess.case_coverage): each case of the
     rows' scene with the rows whose report.json names it, the time each reached
-    against the case's t_end (read here from the scene file), and what it set beyond
-    the case's own overrides; a case counts only from a row at its own settings that
+    against the case's t_end (read here from the scene file), what it set beyond the
+    case's own overrides or lacks of them, and whether its scene changed since its
+    commit; a case counts only from a row at its own settings, on today's scene, that
     reached t_end."""
     import tomllib
+
+    from postprocess import case_coverage
     scenes = ROOT / "mpipd" / "input" / "scenes"
-    t_end = tomllib.loads((scenes / "blast_demo.toml").read_text())["time"]["t_end"] * 1e6
-    sets = tomllib.loads((scenes / "cases" / "blast_demo.toml").read_text())
-    rows = {"base": ("blast_demo", ["output.every=100"], t_end),
-            "c1": ("blast_demo-case1", [*sets["case1"]["set"], 'scene.name="blast_demo-case1"'],
-                   t_end),
-            "c5": ("blast_demo-case5", [*sets["case5"]["set"], 'scene.name="blast_demo-case5"',
-                                        "parts.2.dx=1.2e-3"], 0.5 * t_end)}
+    base = tomllib.loads((scenes / "blast_demo.toml").read_text())
+    cases = tomllib.loads((scenes / "cases" / "blast_demo.toml").read_text())
+    t_end = base["time"]["t_end"] * 1e6
+    old = {**base, "time": {**base["time"], "dt": 0.5 * base["time"]["dt"]}}
+
+    def at(commit, rel):            # the scene files at a commit: "0ld..." had another dt
+        if rel == "blast_demo.toml":
+            return old if commit.startswith("0ld") else base
+        return cases if rel == "cases/blast_demo.toml" else None
+    monkeypatch.setattr(case_coverage, "_file_at", at)
+    name = 'scene.name="blast_demo-{}"'.format
+    rows = {"base": ("blast_demo", ["output.every=100"], t_end, "a" * 40),
+            "old": ("blast_demo", [], t_end, "0ld" + "a" * 37),
+            "c1": ("blast_demo-case1", [*cases["case1"]["set"], name("case1")], t_end, "b" * 40),
+            "c2": ("blast_demo-case2", [cases["case2"]["set"][0], name("case2")], t_end, "c" * 40),
+            "c5": ("blast_demo-case5", [*cases["case5"]["set"], name("case5"), "parts.2.dx=1.2e-3"],
+                   0.5 * t_end, "d" * 40)}
     dirs = []
-    for case, (scene, overrides, reached) in rows.items():
+    for case, (scene, overrides, reached, commit) in rows.items():
         doc = report_json(case, {t.key: inside(t) for t in TARGETS})
         doc["model"].update(scene=scene, overrides=overrides)
         doc["t_end_us"] = reached
+        doc["run"]["git_commit"] = commit
         dirs.append(str(write_report(tmp_path / case / "report", doc)))
     assert main(["validate", "--out", str(tmp_path / "v" / "validation"), *dirs]) == 0
     md = (tmp_path / "v" / "validation.md").read_text()
     got = {r[0]: r[3] for r in table(md, "### blast_demo")[2:]}
-    assert set(got) == {"(the scene)", *sets}
+    assert set(got) == {"(the scene)", *cases}
     end = f"{t_end:.4g}"
-    assert got["(the scene)"] == f"base ({end} of {end} µs, 0123456)"
-    assert got["case1"] == f"c1 ({end} of {end} µs, 0123456)"
-    assert got["case5"] == (f"c5 ({0.5 * t_end:.4g} of {end} µs: **stopped early**, 0123456; "
+    assert got["(the scene)"] == (f"base ({end} of {end} µs, aaaaaaa)<br>old ({end} of {end} µs, "
+                                  "0ldaaaa; blast_demo.toml has changed since)")
+    assert got["case1"] == f"c1 ({end} of {end} µs, bbbbbbb)"
+    lacks = ", ".join(f"`{o}`" for o in cases["case2"]["set"][1:])
+    assert got["case2"] == f"c2 ({end} of {end} µs, ccccccc; lacks {lacks})"
+    assert got["case5"] == (f"c5 ({0.5 * t_end:.4g} of {end} µs: **stopped early**, ddddddd; "
                             "also `parts.2.dx=1.2e-3`)")
-    assert got["case2"] == "not run in this record"
-    left = [c for c in sets if c != "case1"]
-    assert (f"blast_demo: 2 of {len(sets) + 1} (the scene and its {len(sets)} cases) have a "
-            "row at their own settings that reached t_end; not: " + ", ".join(left) + ".") in md
+    assert got["case3"] == "not run in this record"
+    left = [c for c in cases if c != "case1"]
+    assert (f"blast_demo: 2 of {len(cases) + 1} (the scene and its {len(cases)} cases) have a "
+            "row at their own settings, on today's scene, that reached t_end; not: "
+            + ", ".join(left) + ".") in md
+
+
+def test_named_cases_read_the_scene_at_a_commit_with_git():
+    """case_coverage reads a scene file at a commit with git: at HEAD it is today's."""
+    import shutil
+
+    from postprocess import case_coverage
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--",
+                            "mpipd/input/scenes"], capture_output=True, text=True).stdout.strip()
+    if dirty:
+        pytest.skip("the scene files have uncommitted changes")
+    assert case_coverage.scene_changed(head, "blast_demo", "case1") == ""
+    assert case_coverage.scene_changed("0" * 40, "blast_demo", "") is None
