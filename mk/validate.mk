@@ -51,7 +51,7 @@
 #   mpirun -n 2 mpipd run blast_paper:case1 --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_case1
 # blast_paper_case2 (11f9901 to step 920, then resumed at c65e0b2, the same physics, notes §29): the same with case2,
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_case2/checkpoint.h5
-# blast_paper_case5 (2103603, notes §32) and blast_paper_case6 (e6478e9, notes §32; the commits between them
+# blast_paper_case5 (2103603, notes §32) and blast_paper_case6 (553bbef, notes §32; the commits between them
 #   change no built-in scene's arithmetic): the same with case5 and case6
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
