@@ -115,7 +115,7 @@ class Simulation:
                                    self.mode, self.classes, dt_ratio, contact=sv.contact,
                                    viscosity=sv.viscosity, tl=self.tl)
         self.corr.register(st)
-        self.n_spring_global = team.sum(self.corr.rebuild_shape())
+        self.corr.rebuild_shape()
         self.corr.floor_switches = 0            # the start's fallback points are no switches
         # the ghost-force correction exists only where dx or the horizon changes
         tl_parts = [q for k, q in enumerate(scene.parts) if k not in gas_parts]

@@ -423,7 +423,7 @@ def test_too_few_bonds_fall_back_to_springs_and_are_counted(team, tmp_path):
                       "velocity": [1.0, 0.0, 0.0]}]}
     d["time"]["dt"] = 0.5 * critical_dt(make_scene(d))
     sim = Simulation(make_scene(d), team)
-    assert sim.n_spring_global == 20 * 10                 # the plate, not the block
+    assert sim.spring_points() == 20 * 10                 # the plate, not the block
     ke0 = sim.energies().kinetic
     Watch(sim, tol=1e-3).run(200)
     # the fallback springs' elastic energy is not in the energy record (solver gap,
