@@ -124,7 +124,6 @@ def fmt(v):
 
 def table(runs: dict) -> str:
     labels = list(runs)
-    ref = runs[labels[0]]
     head = "| quantity | " + " | ".join(labels) + " |\n|---|" + "---|" * len(labels) + "\n"
     rows = []
 
@@ -144,9 +143,13 @@ def table(runs: dict) -> str:
     row("bonds broken", lambda r: r["broken"])
     row("ledger balance at the end", lambda r: r["balance"])
     row("ledger multirate term (J)", lambda r: r["multirate"])
-    for k, (label, unit, _) in enumerate(ref["targets"]):
+    seen = {}                       # by label: a row one report lacks is None there
+    for r in runs.values():
+        for label, unit, _ in r["targets"]:
+            seen.setdefault(label, unit)
+    for label, unit in seen.items():
         row(f"{label} ({unit})" if unit else label,
-            lambda r, k=k: r["targets"][k][2] if k < len(r["targets"]) else None)
+            lambda r, label=label: next((v for lb, _, v in r["targets"] if lb == label), None))
     return head + "\n".join(rows) + "\n"
 
 

@@ -11,7 +11,9 @@
 Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
 sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
-zone, and the median for the count of major radial cracks.  The lattice bias
+zone, and the median for the count of major radial cracks; the crack orientation
+(:mod:`postprocess.crack_orientation`: radial, oblique, circumferential, and the
+ring arcs) on the same sections.  The lattice bias
 (:mod:`postprocess.lattice_bias`: 4- and 8-fold Fourier amplitudes of the failed
 points' angles in the zone-2 ring) is measured on every gathered section at the
 last frame.
@@ -24,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import cracks, errors, explosive, lattice_bias, ledger, peaks, volume
+from . import crack_orientation, cracks, errors, explosive, lattice_bias, ledger, peaks, volume
 from . import probe_metrics as pm
 from . import sections as secs
 from .targets import TARGETS, verdict
@@ -67,7 +69,8 @@ def _fracture(data_sections, model, last) -> dict:
         args = (sec["x"], sec["y"], failed, model.center, sec["h"], model.r_wall, model.r_out)
         out[name] = {"z_mm": z * 1e3, "zones": cracks.crack_density(*args),
                      "radial_cracks": cracks.radial_cracks(*args, horizon=sec["link"]),
-                     "crushed_zone": cracks.crushed_zone(*args)}
+                     "crushed_zone": cracks.crushed_zone(*args),
+                     "orientation": crack_orientation.measure(*args, horizon=sec["link"])}
     names = [n for n in CRACK_SECTIONS if n in out]
     dens = [[out[n]["zones"][k]["density_mm_per_mm2"] for n in names] for k in range(3)]
     return {"criterion": crit, "sections": out,
@@ -77,7 +80,13 @@ def _fracture(data_sections, model, last) -> dict:
             "crushed_extent_borehole_radii": float(np.mean(
                 [out[n]["crushed_zone"]["extent_borehole_radii"] for n in names])),
             "crushed_extent_mm": float(np.mean([out[n]["crushed_zone"]["extent_mm"]
-                                                for n in names]))}
+                                                for n in names])),
+            "mean_circumferential_density_mm_per_mm2": [float(np.mean(
+                [out[n]["orientation"]["zones"][k]["circumferential_density_mm_per_mm2"]
+                 for n in names])) for k in range(3)],
+            "ring_arc_length_mm": float(np.mean([out[n]["orientation"]["ring_arc_length_mm"]
+                                                 for n in names])),
+            "ring_arcs": float(np.median([out[n]["orientation"]["ring_arcs"] for n in names]))}
 
 
 def _lattice_bias(data_sections, model, last) -> dict:
@@ -206,6 +215,7 @@ def target_values(m: dict) -> dict:
         **{f"crack_density_zone{k + 1}": (dens[k] if dens else fr) for k in range(3)},
         "major_radial_cracks": _get(fr, "major_radial_cracks"),
         "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
+        "ring_arc_length": _get(fr, "ring_arc_length_mm"),
         "ppv_radius_2p5": _get(m["ppv_radius"], "value_mm"),
         "peak_gas_pressure": _get(m["gas_pressure"], "peak_MPa"),
         "peak_wall_pressure": _get(m["wall_radial_stress"], "peak_MPa"),
@@ -227,6 +237,7 @@ def _bases(m: dict) -> dict:
                              if "fit" in rs and "n_points" in rs["fit"] else ""),
            "major_radial_cracks": f"median of {ns} sections",
            "crushed_zone": f"mean of {ns} sections",
+           "ring_arc_length": f"mean of {ns} sections",
            "ppv_radius_2p5": m["ppv_radius"].get("source", ""),
            "peak_gas_pressure": m["gas_pressure"].get("basis", ""),
            "peak_wall_pressure": m["wall_radial_stress"].get("basis", "")}

@@ -89,6 +89,7 @@ def render(doc) -> str:
         ", ".join(f"{k} {v}" for k, v in fm.items() if k != "note")) + ".", ""]
     L += _fig(doc, "fig13_failure_modes")
     L += _fracture(doc["fracture"]) + _fig(doc, "fig12_crack_density")
+    L += _orientation(doc["fracture"])
     L += _lattice_bias(doc["lattice_bias"])
     L += _probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _containment(doc)
     L += _energy(doc)
@@ -142,6 +143,33 @@ def _fracture(fr) -> list[str]:
           f"{fr['crushed_extent_borehole_radii']:.2f} |",
           "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", ""]
     return L
+
+
+def _orientation(fr) -> list[str]:
+    L = ["## Crack orientation: radial and circumferential (§3.2, §3.5)", ""]
+    if _na(fr) or not all("orientation" in s for s in fr["sections"].values()):
+        return L + ["Not available: " + (fr.get("not_available") or "no orientation in this "
+                                          "report (made before postprocess/crack_orientation.py)")
+                    + ".", ""]
+    o = next(iter(fr["sections"].values()))["orientation"]
+    L += [f"Rule: {o['rule']} (`postprocess/crack_orientation.py`).  Crack length per class "
+          "(mm, failed points × dx) in each zone; the circumferential density is its length "
+          "over the ring's area, as in Fig. 12.", "",
+          "| section | zone | failed points | radial | oblique | circumferential | unresolved "
+          "| isolated | circumferential density (mm/mm²) |", "|---|---|---|---|---|---|---|---|---|"]
+    for name, s in fr["sections"].items():
+        for z in s["orientation"]["zones"]:
+            L.append(f"| {name} | {z['zone']} | {z['failed_points']} | "
+                     + " | ".join(f"{z[c]['length_mm']:.4g}" for c in
+                                  ("radial", "oblique", "circumferential", "unresolved",
+                                   "isolated"))
+                     + f" | {z['circumferential_density_mm_per_mm2']:.4f} |")
+    L += ["", "| section | ring arcs | total length (mm) | radii (mm) |", "|---|---|---|---|"]
+    for name, s in fr["sections"].items():
+        o = s["orientation"]
+        radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"
+        L.append(f"| {name} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | {radii} |")
+    return L + [""]
 
 
 def _lattice_bias(lb) -> list[str]:

@@ -61,6 +61,10 @@ TARGETS = (
            "6", "several (Fig. 10)", 4, 8, "6 ± 2"),
     Target("crushed_zone", "crushed zone extent beyond the wall (§3.2)", "borehole radii",
            "≈1", "—", 0.5, 1.5, "1 ± 0.5 borehole radius"),
+    Target("ring_arc_length", "ring cracks: circumferential arcs longer than 2 horizons, "
+           "total length on a section (§3.2, §3.5)", "mm",
+           "minor circumferential cracks; more ring cracks in case 5", "spalling (§3.2)",
+           None, None, "information only: the paper gives no number", "information"),
     Target("ppv_radius_2p5", "distance within which PPV > 2.5 m/s (Fig. 18)", "mm",
            "≈20 (text: '2500 m/s', read as mm/s)", "—", 15.0, 25.0, "20 ± 25 %"),
     Target("peak_gas_pressure", "peak explosive pressure, every step (Fig. 7)", "MPa",

@@ -981,8 +981,16 @@ def test_report_on_blast_demo_under_mpirun(demo_run, tmp_path):
     for name in doc["figures"].values():
         assert (tmp_path / "rep2" / name).stat().st_size > 10_000
     md = (tmp_path / "rep2" / "report.md").read_text()
-    # 16 rows: the peak-arrival wave speed is shown beside the judged first-arrival one
-    assert "| quantity | this run |" in md and len(doc["targets"]) == 16
+    # 17 rows: the peak-arrival wave speed is shown beside the judged first-arrival one,
+    # and the ring arcs' length is information
+    assert "| quantity | this run |" in md and len(doc["targets"]) == 17
+    # the crack orientation on each crack section, its classes adding up to the failed
+    for s in doc["fracture"]["sections"].values():
+        for z, zo in zip(s["zones"], s["orientation"]["zones"]):
+            assert zo["failed_points"] == z["failed_points"]
+            assert sum(zo[c]["points"] for c in ("radial", "oblique", "circumferential",
+                                                 "unresolved", "isolated")) == z["failed_points"]
+    assert "## Crack orientation" in md
     assert all(r["verdict"].split(":")[0] in ("within", "outside", "not available",
                                               "information", "error")
                for r in doc["targets"])

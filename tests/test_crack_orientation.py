@@ -1,0 +1,116 @@
+"""Crack orientation (postprocess/crack_orientation.py) on synthetic sections whose
+answer is known by construction: radial rays, a ring, an arc, random failure."""
+import numpy as np
+import pytest
+
+from postprocess import crack_orientation as co
+
+DX = 0.8e-3
+R_WALL, R_OUT = 3.2e-3, 72e-3
+HORIZON = 3 * DX
+
+
+def _section():
+    n = int(np.ceil(R_OUT / DX)) + 1
+    g = (np.arange(-n, n + 1) + 0.5) * DX
+    x, y = np.meshgrid(g, g, indexing="ij")
+    x, y = x.ravel(), y.ravel()
+    r = np.hypot(x, y)
+    keep = (r >= R_WALL) & (r <= R_OUT)
+    return x[keep], y[keep]
+
+
+def _rays(x, y, angles_deg, width=DX):
+    """Points within ``width`` of the rays from the axis at the given angles."""
+    out = np.zeros(len(x), bool)
+    for a in np.radians(angles_deg):
+        along = x * np.cos(a) + y * np.sin(a)
+        across = -x * np.sin(a) + y * np.cos(a)
+        out |= (along > 0) & (np.abs(across) < width)
+    return out
+
+
+def _ring(x, y, radius, th0=-np.pi, th1=np.pi):
+    th = np.arctan2(y, x)
+    return (np.abs(np.hypot(x, y) - radius) < 0.6 * DX) & (th >= th0) & (th <= th1)
+
+
+def _classes(m):
+    return {c: sum(z[c]["points"] for z in m["zones"]) for c in co.CLASSES}
+
+
+def test_direction_is_the_principal_axis_of_the_neighbourhood():
+    """The closed-form 2x2 eigenvector against numpy's eigh, on random clusters."""
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(40, 2)) * [3e-3, 0.5e-3]
+    rot = np.radians(37.0)
+    pts = pts @ np.array([[np.cos(rot), np.sin(rot)], [-np.sin(rot), np.cos(rot)]])
+    big = np.full(len(pts), 1.0)            # every point sees every other
+    t, ratio, count = co.local_directions(pts[:, 0], pts[:, 1], np.ones(len(pts), bool), big)
+    d = pts - pts.mean(axis=0)
+    lam, vec = np.linalg.eigh(d.T @ d / len(pts))
+    assert np.all(count == len(pts))
+    assert np.allclose(np.abs(t @ vec[:, 1]), 1.0, atol=1e-12)
+    assert np.allclose(ratio, lam[0] / lam[1], rtol=1e-10)
+
+
+def test_radial_rays_are_radial():
+    x, y = _section()
+    failed = _rays(x, y, [10, 70, 130, 190, 250, 310])
+    m = co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
+    outer = [z for z in m["zones"] if z["zone"] > 1]
+    rad = sum(z["radial"]["points"] for z in outer)
+    circ = sum(z["circumferential"]["points"] for z in outer)
+    assert rad > 0.95 * sum(z["failed_points"] for z in outer)
+    assert circ == 0
+    assert m["ring_arcs"] == 0
+
+
+def test_a_ring_is_circumferential_with_its_length():
+    x, y = _section()
+    failed = _ring(x, y, 40e-3)
+    m = co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
+    c = _classes(m)
+    assert c["circumferential"] > 0.95 * np.count_nonzero(failed)
+    assert m["ring_arcs"] == 1
+    # its length, each point standing for dx (Fig. 12's rule): the band |r - R| < 0.6 dx
+    # holds about 1.2 x 2 pi R / dx points
+    assert m["ring_arc_length_mm"] == pytest.approx(np.count_nonzero(failed) * DX * 1e3)
+    assert m["ring_arc_length_mm"] == pytest.approx(1.2 * 2 * np.pi * 40.0, rel=0.05)
+    z2 = m["zones"][1]                       # 26.1-49.1 mm holds r = 40 mm
+    area = np.pi * (z2["r_mm"][1] ** 2 - z2["r_mm"][0] ** 2)
+    assert z2["circumferential_density_mm_per_mm2"] == pytest.approx(
+        z2["circumferential"]["length_mm"] / area)
+    assert z2["circumferential"]["points"] == c["circumferential"]
+
+
+def test_an_arc_between_rays_is_one_ring_arc_and_a_short_one_none():
+    x, y = _section()
+    arc = _ring(x, y, 40e-3, np.radians(20), np.radians(60))
+    short = _ring(x, y, 60e-3, np.radians(100), np.radians(100) + 1.5 * HORIZON / 60e-3)
+    failed = _rays(x, y, [10, 70, 130, 190, 250, 310]) | arc | short
+    m = co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
+    assert m["ring_arcs"] == 1
+    assert m["rings"][0]["r_mm"] == pytest.approx(40.0, abs=0.5)
+    # 1.2 points per dx of arc (the band 1.2 dx wide), the ends' few points unclassed
+    assert m["rings"][0]["length_mm"] == pytest.approx(1.2 * 40.0 * np.radians(40), rel=0.1)
+    assert m["rings"][0]["points"] > 0.9 * np.count_nonzero(arc)
+
+
+def test_random_failure_has_no_preferred_direction():
+    """Failure independent of direction: about a third of the classified points in
+    each class (psi uniform on [0, 90 deg])."""
+    x, y = _section()
+    rng = np.random.default_rng(11)
+    failed = (rng.random(len(x)) < 0.12) & (np.hypot(x, y) > 26e-3)
+    c = _classes(co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON))
+    n = c["radial"] + c["oblique"] + c["circumferential"]
+    assert n > 500
+    for k in ("radial", "oblique", "circumferential"):
+        assert 0.25 < c[k] / n < 0.42, (k, c[k] / n)
+
+
+def test_no_failure():
+    x, y = _section()
+    m = co.measure(x, y, np.zeros(len(x), bool), (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
+    assert m["ring_arcs"] == 0 and all(z["failed_points"] == 0 for z in m["zones"])

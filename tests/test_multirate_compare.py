@@ -1,0 +1,27 @@
+"""benchmarks/multirate_compare.py's table: target rows are matched by label, so a
+report made before a row existed (docs/validation/<case>/report.json) shows it as
+missing instead of shifting every row below it."""
+import importlib.util
+from pathlib import Path
+
+spec = importlib.util.spec_from_file_location(
+    "multirate_compare", Path(__file__).resolve().parents[1] / "benchmarks" / "multirate_compare.py")
+mc = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(mc)
+
+
+def _run(targets):
+    return {"commit": "abc", "ranks": 2, "dt": 2e-8, "wall": 10.0, "evaluated": None,
+            "modes": [0, 1, 2, 3], "broken": 5, "balance": 0.0, "multirate": 0.0,
+            "targets": targets}
+
+
+def test_rows_are_matched_by_label():
+    old = _run([("crushed zone", "R_b", 3.0), ("PPV radius", "mm", 20.0)])
+    new = _run([("crushed zone", "R_b", 4.0), ("ring arcs", "mm", 7.0),
+                ("PPV radius", "mm", 30.0)])
+    rows = {line.split(" | ")[0].lstrip("| "): line
+            for line in mc.table({"base": old, "case": new}).splitlines()}
+    assert rows["PPV radius (mm)"].endswith("| 20 | 30 (+50.0 %) |")
+    assert rows["crushed zone (R_b)"].endswith("| 3 | 4 (+33.3 %) |")
+    assert rows["ring arcs (mm)"].endswith("| — | 7 |")
