@@ -383,6 +383,54 @@ def bias_table(runs) -> list[str]:
     return L
 
 
+ORIENT_CLASSES = ("radial", "oblique", "circumferential", "unresolved", "isolated")
+
+
+def orientation_table(runs) -> list[str]:
+    """Crack orientation per run and section (report.json ``fracture.sections.*.
+    orientation``, :mod:`postprocess.crack_orientation`): the share of each class in
+    zones 2-3, the circumferential density per zone and the ring arcs."""
+    def secs(r):
+        fr = r["doc"].get("fracture", {})
+        s = fr.get("sections", {}) if isinstance(fr, dict) else {}
+        return {n: v["orientation"] for n, v in s.items()
+                if isinstance(v, dict) and "orientation" in v}
+    have = [r for r in runs if secs(r)]
+    if not have:
+        return []
+    L = ["## Crack orientation", "",
+         "From `fracture.sections.*.orientation` of each report.json "
+         "(postprocess/crack_orientation.py): the local direction of the failed points "
+         "within the horizon, classed radial (< 30° from e_r), oblique or circumferential "
+         "(> 60°) where they form a line; junctions, the crushed zone and wide bands are "
+         "unresolved.  Shares are of the failed crack length in zones 2 and 3; the ring "
+         "arcs are chains of circumferential points longer than two horizons (their count "
+         "splits at each radial crack that crosses them).", "",
+         "| run | section | " + " | ".join(f"{c} (zones 2–3)" for c in ORIENT_CLASSES)
+         + " | circumferential density zones 1 / 2 / 3 (mm/mm²) | ring arcs | "
+         "ring-arc length (mm) | ring-arc radii (mm) |",
+         "|---|---|" + "---|" * (len(ORIENT_CLASSES) + 4)]
+    for r in have:
+        for name, o in secs(r).items():
+            outer = o["zones"][1:]
+            tot = sum(z[c]["length_mm"] for z in outer for c in ORIENT_CLASSES)
+            share = [sum(z[c]["length_mm"] for z in outer) / tot if tot else float("nan")
+                     for c in ORIENT_CLASSES]
+            dens = " / ".join(f"{z['circumferential_density_mm_per_mm2']:.3f}"
+                              for z in o["zones"])
+            radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"
+            L.append(f"| {r['case']} | {_cell(name)} | "
+                     + " | ".join(f"{v:.2f}" for v in share)
+                     + f" | {dens} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | "
+                     f"{radii} |")
+    L.append("")
+    without = [r["case"] for r in runs if r not in have]
+    if without:
+        L += [f"No crack orientation in the report.json of (made before it existed): "
+              f"{', '.join(without)}.", ""]
+    return L
+
+
 def threshold_table(runs) -> list[str]:
     """The first-arrival speed at each fraction of the probes' peaks (report.json
     ``wave_speed.threshold_study``): how much of the judged speed is the measure."""
@@ -431,7 +479,7 @@ def render(runs, command, code_commit, notes) -> str:
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
     L += (provenance(runs) + coverage_table(runs) + targets_table(runs) + threshold_table(runs)
-          + bias_table(runs))
+          + bias_table(runs) + orientation_table(runs))
     for k, r in enumerate(runs, 1):
         L += run_section(k, r)
     L += ["## Diagnoses", ""]

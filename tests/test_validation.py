@@ -373,3 +373,25 @@ def test_named_cases_read_the_scene_at_a_commit_with_git():
         assert case_coverage._file_at(head, rel) == tomllib.loads(text)
     assert case_coverage._file_at("0" * 40, "blast_demo.toml") is None
     assert case_coverage.scene_changed("0" * 40, "blast_demo", "") is None
+
+
+def test_orientation_table():
+    """Shares of the failed crack length in zones 2-3 per class, computed by hand."""
+    def zone(k, lengths, dens):
+        z = {"zone": k, "circumferential_density_mm_per_mm2": dens}
+        z.update({c: {"points": 0, "length_mm": v} for c, v in zip(
+            validation.ORIENT_CLASSES, lengths)})
+        return z
+    orient = {"zones": [zone(1, (0, 0, 0, 90, 0), 0.0), zone(2, (6, 2, 4, 7, 1), 0.01),
+                        zone(3, (10, 2, 6, 1, 1), 0.004)],
+              "ring_arcs": 2, "ring_arc_length_mm": 12.5,
+              "rings": [{"r_mm": 21.44, "length_mm": 6.0}, {"r_mm": 30.1, "length_mm": 6.5}]}
+    runs = [{"case": "alpha", "doc": {"fracture": {"sections": {"mid": {"orientation": orient}}}}},
+            {"case": "beta", "doc": {"fracture": {"sections": {"mid": {"zones": []}}}}}]
+    L = validation.orientation_table(runs)
+    rows = table("\n".join(L), "## Crack orientation")
+    # zones 2-3: radial 16, oblique 4, circumferential 10, unresolved 8, isolated 2 of 40
+    assert rows[2] == ["alpha", "mid", "0.40", "0.10", "0.25", "0.20", "0.05",
+                       "0.000 / 0.010 / 0.004", "2", "12.5", "21.4, 30.1"]
+    assert len(rows) == 3
+    assert any("made before it existed): beta." in ln for ln in L)
