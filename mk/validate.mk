@@ -53,13 +53,15 @@
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_case2/checkpoint.h5
 # blast_paper_case5 (2103603, notes §32) and blast_paper_case6 (553bbef, notes §32; the commits between them
 #   change no built-in scene's arithmetic): the same with case5 and case6
+# blast_paper_slab (a71b23f, notes §33): the same with slab (the integration's test bed, 10 mm thick, 40 mm in radius)
+# blast_paper_case3 (a71b23f, notes §33): the same with case3
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
     runs/blast_paper_buffer_graded/run.h5 runs/blast_paper_row_sum/run.h5 runs/blast_paper_dx1.2_buffer_graded/run.h5 \
     runs/blast_paper_row_sum_part/run.h5 runs/blast_paper_window0/run.h5 runs/blast_paper_kernels/run.h5 \
     runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 runs/blast_paper_case1/run.h5 runs/blast_paper_case2/run.h5 \
-    runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
+    runs/blast_paper_case3/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 runs/blast_paper_slab/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation

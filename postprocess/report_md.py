@@ -147,7 +147,8 @@ def _fracture(fr) -> list[str]:
 
 def _orientation(fr) -> list[str]:
     L = ["## Crack orientation: radial and circumferential (§3.2, §3.5)", ""]
-    if _na(fr) or not all("orientation" in s for s in fr["sections"].values()):
+    if _na(fr) or not fr["sections"] or not all("orientation" in s
+                                                 for s in fr["sections"].values()):
         return L + ["Not available: " + (fr.get("not_available") or "no orientation in this "
                                           "report (made before postprocess/crack_orientation.py)")
                     + ".", ""]
