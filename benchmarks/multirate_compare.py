@@ -143,14 +143,28 @@ def table(runs: dict) -> str:
     row("bonds broken", lambda r: r["broken"])
     row("ledger balance at the end", lambda r: r["balance"])
     row("ledger multirate term (J)", lambda r: r["multirate"])
-    seen = {}                       # by label: a row one report lacks is None there
-    for r in runs.values():
-        for label, unit, _ in r["targets"]:
-            seen.setdefault(label, unit)
-    for label, unit in seen.items():
-        row(f"{label} ({unit})" if unit else label,
-            lambda r, label=label: next((v for lb, _, v in r["targets"] if lb == label), None))
+    for name in merged_names(runs.values(), target_names):
+        row(name, lambda r, name=name: dict(target_names(r)).get(name))
     return head + "\n".join(rows) + "\n"
+
+
+def target_names(r) -> list[tuple[str, object]]:
+    """(row name, value) of a run's target rows."""
+    return [(f"{label} ({unit})" if unit else label, v) for label, unit, v in r["targets"]]
+
+
+def merged_names(runs, rows) -> list[str]:
+    """The row names of every run, each once, matched by name (a row one report lacks,
+    made before the row existed, is None there): in the first run's order, a name
+    another run adds placed after the name it follows in that run."""
+    out: list[str] = []
+    for r in runs:
+        prev = None
+        for name, _ in rows(r):
+            if name not in out:
+                out.insert(out.index(prev) + 1 if prev is not None else 0, name)
+            prev = name
+    return out
 
 
 def quantities(r) -> list[tuple[str, object]]:
@@ -158,8 +172,7 @@ def quantities(r) -> list[tuple[str, object]]:
     out = [("bond states evaluated (of single-rate's)", r["evaluated"]),
            ("failed: JH2 plastic", r["modes"][1]), ("failed: tension model", r["modes"][3]),
            ("bonds broken", r["broken"]), ("ledger balance at the end", r["balance"])]
-    out += [(f"{label} ({unit})" if unit else label, v) for label, unit, v in r["targets"]]
-    return out
+    return out + target_names(r)
 
 
 def bands(runs: dict, groups: list[str], stats: bool = False) -> str:
@@ -171,12 +184,12 @@ def bands(runs: dict, groups: list[str], stats: bool = False) -> str:
         raise SystemExit(f"multirate_compare: no run label starts with {empty[0]!r}_")
     head = ("| quantity | " + " | ".join(f"{g} ({len(members[g])} runs)" for g in groups)
             + " | ranges overlap |\n|---|" + "---|" * (len(groups) + 1) + "\n")
-    names = [n for n, _ in quantities(runs[members[groups[0]][0]])]
+    names = merged_names([runs[k] for g in groups for k in members[g]], quantities)
     rows = []
-    for i, name in enumerate(names):
+    for name in names:
         rng = []
         for g in groups:
-            vals = [quantities(runs[k])[i][1] for k in members[g]]
+            vals = [dict(quantities(runs[k])).get(name) for k in members[g]]
             vals = [float(v) for v in vals if isinstance(v, (int, float))]
             rng.append((min(vals), max(vals), vals) if vals else None)
         if any(x is None for x in rng):

@@ -17,8 +17,9 @@ included) are its neighbourhood; with C_i their covariance about their centroid,
 the crack runs along the eigenvector t_i of l1 where the neighbourhood is a line:
 l2 <= LINEAR * l1 (a chain two points wide and seven long has l2/l1 ~ 0.06; a
 full disc of failed points 1).  A point with fewer than MIN_NEIGHBOURS failed
-neighbours is *isolated*; one whose neighbourhood is not a line (a junction, the
-crushed zone, a cluster) is *unresolved*.  The others are classed by the angle psi
+points within its horizon, itself included, is *isolated*; one whose
+neighbourhood is not a line (a junction, the crushed zone, a band wider than
+about three points) is *unresolved*.  The others are classed by the angle psi
 between t_i and the radial direction e_r = (x_i - c)/|x_i - c|:
 
     radial           psi <  30 deg
@@ -29,17 +30,20 @@ so that failure whose direction is random gives each class a third of the
 classified points (psi uniform on [0, 90 deg]).
 
 Per crack-density zone (:func:`postprocess.cracks.zone_edges`), each class's
-count and its crack length (each point stands for its own dx, as in Fig. 12),
-and the circumferential crack density: circumferential length / ring area
-(mm/mm^2, the same area as Fig. 12's).
+count and its crack length (each point stands for its own dx, as in Fig. 12: a
+crack two points wide counts twice, as in the crack density), and the
+circumferential crack density: circumferential length / ring area (mm/mm^2, the
+same area as Fig. 12's).
 
 Ring arcs.  The circumferential points joined within the larger of their
-horizons (max-norm, as the radial cracks' chains) form arcs; an arc counts when
-its length (points x dx) is at least RING_MIN_HORIZONS horizons: longer than any
-single neighbourhood.  Their count, radii (mean r) and lengths are reported.  A
-radial crack that crosses a ring makes the points about the crossing unresolved
-(not a line), so a ring crossed by k radial cracks is k arcs: the count is of
-arcs, the length is the measure of how much ring cracking there is.
+horizons (max-norm, as the radial cracks' chains) form arcs.  An arc's length is
+geometric, its mean radius times the angle it covers (:func:`arc_span`), so a
+crack two points wide is not counted twice; it counts when that length is at
+least RING_MIN_HORIZONS horizons: longer than any single neighbourhood.  Their
+count, radii (mean r) and lengths are reported.  A radial crack that crosses a
+ring makes the points about the crossing unresolved (not a line), so a ring
+crossed by k radial cracks is k arcs: the count is of arcs, the length is the
+measure of how much ring cracking there is.
 """
 from __future__ import annotations
 
@@ -100,16 +104,28 @@ def classify(x, y, failed, center, horizon) -> np.ndarray:
     return out
 
 
+def arc_span(theta: np.ndarray) -> float:
+    """Angle (rad) an arc's points cover: 2 pi less the largest gap between neighbours
+    in angle (the gap across +-pi included), 0 for one point."""
+    if len(theta) < 2:
+        return 0.0
+    t = np.sort(theta)
+    gaps = np.append(np.diff(t), t[0] + 2.0 * np.pi - t[-1])
+    return float(2.0 * np.pi - gaps.max())
+
+
 def ring_arcs(x, y, circ, center, dx, horizon) -> list[dict]:
-    """Arcs of circumferential points at least RING_MIN_HORIZONS horizons long."""
+    """Arcs of circumferential points whose length (mean radius x angular span) is at
+    least RING_MIN_HORIZONS horizons."""
     if not np.any(circ):
         return []
     lab = cracks._cracks(x, y, circ, horizon)
     r = np.hypot(x - center[0], y - center[1])
+    th = np.arctan2(y - center[1], x - center[0])
     out = []
     for k in range(1, int(lab.max()) + 1):
         m = lab == k
-        length = float(dx[m].sum())
+        length = float(r[m].mean()) * arc_span(th[m])
         if length >= RING_MIN_HORIZONS * float(horizon[m].max()):
             out.append({"r_mm": float(r[m].mean()) * 1e3, "length_mm": length * 1e3,
                         "points": int(np.count_nonzero(m))})

@@ -147,11 +147,13 @@ def _fracture(fr) -> list[str]:
 
 def _orientation(fr) -> list[str]:
     L = ["## Crack orientation: radial and circumferential (§3.2, §3.5)", ""]
-    if _na(fr) or not fr["sections"] or not all("orientation" in s
-                                                 for s in fr["sections"].values()):
-        return L + ["Not available: " + (fr.get("not_available") or "no orientation in this "
-                                          "report (made before postprocess/crack_orientation.py)")
-                    + ".", ""]
+    if _na(fr):
+        return L + [f"Not available: {fr['not_available']}.", ""]
+    if not fr["sections"]:
+        return L + ["Not available: no crack section.", ""]
+    if not all("orientation" in s for s in fr["sections"].values()):
+        return L + ["Not available: no orientation in this report (made before "
+                    "postprocess/crack_orientation.py).", ""]
     o = next(iter(fr["sections"].values()))["orientation"]
     L += [f"Rule: {o['rule']} (`postprocess/crack_orientation.py`).  Crack length per class "
           "(mm, failed points × dx) in each zone; the circumferential density is its length "
@@ -165,7 +167,8 @@ def _orientation(fr) -> list[str]:
                                   ("radial", "oblique", "circumferential", "unresolved",
                                    "isolated"))
                      + f" | {z['circumferential_density_mm_per_mm2']:.4f} |")
-    L += ["", "| section | ring arcs | total length (mm) | radii (mm) |", "|---|---|---|---|"]
+    L += ["", "Ring arcs: length = mean radius × the angle covered.", "",
+          "| section | ring arcs | total length (mm) | radii (mm) |", "|---|---|---|---|"]
     for name, s in fr["sections"].items():
         o = s["orientation"]
         radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"

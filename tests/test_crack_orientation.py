@@ -73,10 +73,12 @@ def test_a_ring_is_circumferential_with_its_length():
     c = _classes(m)
     assert c["circumferential"] > 0.95 * np.count_nonzero(failed)
     assert m["ring_arcs"] == 1
-    # its length, each point standing for dx (Fig. 12's rule): the band |r - R| < 0.6 dx
-    # holds about 1.2 x 2 pi R / dx points
-    assert m["ring_arc_length_mm"] == pytest.approx(np.count_nonzero(failed) * DX * 1e3)
-    assert m["ring_arc_length_mm"] == pytest.approx(1.2 * 2 * np.pi * 40.0, rel=0.05)
+    # the arc's length is geometric: 2 pi R whatever the band's width
+    assert m["ring_arc_length_mm"] == pytest.approx(2 * np.pi * 40.0, rel=0.01)
+    # the per-zone class length follows Fig. 12 (each point stands for dx): the band
+    # |r - R| < 0.6 dx holds about 1.2 x 2 pi R / dx points
+    assert m["zones"][1]["circumferential"]["length_mm"] == pytest.approx(
+        1.2 * 2 * np.pi * 40.0, rel=0.05)
     z2 = m["zones"][1]                       # 26.1-49.1 mm holds r = 40 mm
     area = np.pi * (z2["r_mm"][1] ** 2 - z2["r_mm"][0] ** 2)
     assert z2["circumferential_density_mm_per_mm2"] == pytest.approx(
@@ -92,9 +94,57 @@ def test_an_arc_between_rays_is_one_ring_arc_and_a_short_one_none():
     m = co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
     assert m["ring_arcs"] == 1
     assert m["rings"][0]["r_mm"] == pytest.approx(40.0, abs=0.5)
-    # 1.2 points per dx of arc (the band 1.2 dx wide), the ends' few points unclassed
-    assert m["rings"][0]["length_mm"] == pytest.approx(1.2 * 40.0 * np.radians(40), rel=0.1)
+    # R x the angle (the ends' few points unclassed)
+    assert m["rings"][0]["length_mm"] == pytest.approx(40.0 * np.radians(40), rel=0.08)
     assert m["rings"][0]["points"] > 0.9 * np.count_nonzero(arc)
+
+
+def test_a_short_wide_arc_is_not_a_ring_arc():
+    """An arc 1.5 horizons long and two points wide: 2 x its length in points x dx,
+    but shorter than two horizons."""
+    x, y = _section()
+    th0 = np.radians(100)
+    th1 = th0 + 1.5 * HORIZON / 40e-3
+    th = np.arctan2(y, x)
+    wide = (np.abs(np.hypot(x, y) - 40e-3) < DX) & (th >= th0) & (th <= th1)
+    m = co.measure(x, y, wide, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
+    assert np.count_nonzero(wide) * DX > 2 * HORIZON       # points x dx would count it
+    assert _classes(m)["circumferential"] > 0.5 * np.count_nonzero(wide)
+    assert m["ring_arcs"] == 0
+
+
+def test_oblique_and_isolated():
+    """Lines at 45 deg to the radius are oblique; lone points are isolated."""
+    x, y = _section()
+    failed = np.zeros(len(x), bool)
+    for cx, cy in ((30e-3, 0.0), (0.0, -45e-3), (-40e-3, 20e-3)):
+        # a line through (cx, cy) at 45 deg to e_r there
+        a = np.arctan2(cy, cx) + np.pi / 4
+        along = (x - cx) * np.cos(a) + (y - cy) * np.sin(a)
+        across = -(x - cx) * np.sin(a) + (y - cy) * np.cos(a)
+        failed |= (np.abs(along) < 4e-3) & (np.abs(across) < 0.5 * DX)
+    lone = [np.argmin(np.hypot(x - px, y - py)) for px, py in ((20e-3, 40e-3), (-60e-3, -5e-3))]
+    failed[lone] = True
+    cls = co.classify(x, y, failed, (0.0, 0.0), HORIZON)
+    assert np.all(cls[lone] == co.CLASSES.index("isolated"))
+    line = failed.copy()
+    line[lone] = False
+    c = cls[line]
+    assert np.count_nonzero(c == co.CLASSES.index("oblique")) > 0.8 * len(c)   # ends: few
+    assert not np.any((c == co.CLASSES.index("radial")) | (c == co.CLASSES.index("circumferential")))
+
+
+def test_each_point_uses_its_own_horizon():
+    """A point whose own horizon is below its neighbours' spacing sees only itself
+    (isolated), even though the neighbours' horizons reach it."""
+    x = np.arange(10) * 1e-3 + 30e-3
+    y = np.zeros(10)
+    h = np.full(10, 3.1e-3)
+    h[5] = 0.5e-3
+    t, ratio, count = co.local_directions(x, y, np.ones(10, bool), h)
+    assert count[5] == 1
+    assert count[4] == 7 and count[0] == 4      # points within 3.1 mm, itself included
+    assert np.allclose(np.abs(t[[0, 4, 9]][:, 0]), 1.0) and np.allclose(ratio[[0, 4, 9]], 0)
 
 
 def test_random_failure_has_no_preferred_direction():
