@@ -54,7 +54,7 @@
 # blast_paper_case5 (2103603, notes §32) and blast_paper_case6 (553bbef, notes §32; the commits between them
 #   change no built-in scene's arithmetic): the same with case5 and case6
 # blast_paper_slab (a71b23f, notes §33): the same with slab (the integration's test bed, 10 mm thick, 40 mm in radius)
-# blast_paper_case3 (a71b23f, notes §33): the same with case3
+# blast_paper_case3 (cd19d8e, whose mpipd/ is a71b23f's: only postprocess changed between them; notes §33): the same with case3
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
