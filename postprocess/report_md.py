@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from mpipd.output.writer import short_commit
 
+from .crack_orientation import CLASSES
+
 
 def _f(v, fmt=".3g"):
     if v is None:
@@ -158,14 +160,12 @@ def _orientation(fr) -> list[str]:
     L += [f"Rule: {o['rule']} (`postprocess/crack_orientation.py`).  Crack length per class "
           "(mm, failed points × dx) in each zone; the circumferential density is its length "
           "over the ring's area, as in Fig. 12.", "",
-          "| section | zone | failed points | radial | oblique | circumferential | unresolved "
-          "| isolated | circumferential density (mm/mm²) |", "|---|---|---|---|---|---|---|---|---|"]
+          "| section | zone | failed points | " + " | ".join(CLASSES)
+          + " | circumferential density (mm/mm²) |", "|---|---|---|" + "---|" * (len(CLASSES) + 1)]
     for name, s in fr["sections"].items():
         for z in s["orientation"]["zones"]:
             L.append(f"| {name} | {z['zone']} | {z['failed_points']} | "
-                     + " | ".join(f"{z[c]['length_mm']:.4g}" for c in
-                                  ("radial", "oblique", "circumferential", "unresolved",
-                                   "isolated"))
+                     + " | ".join(f"{z[c]['length_mm']:.4g}" for c in CLASSES)
                      + f" | {z['circumferential_density_mm_per_mm2']:.4f} |")
     L += ["", "Ring arcs: length = mean radius × the angle covered.", "",
           "| section | ring arcs | total length (mm) | radii (mm) |", "|---|---|---|---|"]

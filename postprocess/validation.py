@@ -38,6 +38,7 @@ from pathlib import Path
 
 from .analysis import target_bounds
 from .case_coverage import coverage_table
+from .crack_orientation import CLASSES
 from .targets import BY_KEY, TARGETS, verdict
 
 MAX_WIDTH = 900
@@ -383,9 +384,6 @@ def bias_table(runs) -> list[str]:
     return L
 
 
-ORIENT_CLASSES = ("radial", "oblique", "circumferential", "unresolved", "isolated")
-
-
 def orientation_table(runs) -> list[str]:
     """Crack orientation per run and section (report.json ``fracture.sections.*.
     orientation``, :mod:`postprocess.crack_orientation`): the share of each class in
@@ -406,16 +404,16 @@ def orientation_table(runs) -> list[str]:
          "unresolved.  Shares are of the failed crack length in zones 2 and 3; the ring "
          "arcs are chains of circumferential points longer than two horizons (their count "
          "splits at each radial crack that crosses them).", "",
-         "| run | section | " + " | ".join(f"{c} (zones 2–3)" for c in ORIENT_CLASSES)
+         "| run | section | " + " | ".join(f"{c} (zones 2–3)" for c in CLASSES)
          + " | circumferential density zones 1 / 2 / 3 (mm/mm²) | ring arcs | "
          "ring-arc length (mm) | ring-arc radii (mm) |",
-         "|---|---|" + "---|" * (len(ORIENT_CLASSES) + 4)]
+         "|---|---|" + "---|" * (len(CLASSES) + 4)]
     for r in have:
         for name, o in secs(r).items():
             outer = o["zones"][1:]
-            tot = sum(z[c]["length_mm"] for z in outer for c in ORIENT_CLASSES)
+            tot = sum(z[c]["length_mm"] for z in outer for c in CLASSES)
             share = [sum(z[c]["length_mm"] for z in outer) / tot if tot else float("nan")
-                     for c in ORIENT_CLASSES]
+                     for c in CLASSES]
             dens = " / ".join(f"{z['circumferential_density_mm_per_mm2']:.3f}"
                               for z in o["zones"])
             radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"

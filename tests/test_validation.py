@@ -14,6 +14,7 @@ from PIL import Image
 
 from postprocess import validation
 from postprocess.__main__ import main
+from postprocess.crack_orientation import CLASSES
 from postprocess.targets import TARGETS, verdict
 
 CONSISTENCY = (6794.0, 15511.0)
@@ -380,7 +381,7 @@ def test_orientation_table():
     def zone(k, lengths, dens):
         z = {"zone": k, "circumferential_density_mm_per_mm2": dens}
         z.update({c: {"points": 0, "length_mm": v} for c, v in zip(
-            validation.ORIENT_CLASSES, lengths)})
+            CLASSES, lengths)})
         return z
     orient = {"zones": [zone(1, (0, 0, 0, 90, 0), 0.0), zone(2, (6, 2, 4, 7, 1), 0.01),
                         zone(3, (10, 2, 6, 1, 1), 0.004)],
