@@ -96,3 +96,15 @@ sensitivity: install
 	$(PY) benchmarks/multirate_compare.py --out $(SENS_OUT) \
 	    --title "Table 3 at the paper's geometry: the base scene (Table 1) and each case run so far; \`make sensitivity\`" \
 	    table1=$(SENS_BASE) $(foreach d,$(SENS_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+
+# `make record`: the same record on a machine that lacks some of VALIDATE_RUNS' run files
+# (a new machine keeps none): each row from its run's report or run file when it is here,
+# else from the row's committed folder docs/validation/<case>/ at HEAD, extracted into
+# runs/rows/<case> (scripts/record_rows.py; the record names that folder as the row's
+# report). Figures already shrunk are copied unchanged, so a row read back is the same.
+.PHONY: record
+record: install
+	@mkdir -p runs
+	@$(PY) scripts/record_rows.py --rows runs/rows $(VALIDATE_RUNS) > runs/record_inputs.txt
+	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
+	    $$(cat runs/record_inputs.txt) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES))

@@ -488,9 +488,14 @@ def render(runs, command, code_commit, notes) -> str:
 # ------------------------------------------------------------------ files
 def shrink_png(src: Path, dst: Path, width: int = MAX_WIDTH) -> tuple[int, int]:
     """``src`` at most ``width`` px wide (aspect kept), on white, as a 256-colour PNG
-    (a third of the size of a full-colour one; the figures have few colours)."""
+    (a third of the size of a full-colour one; the figures have few colours).  A
+    source that is already such a PNG (a committed row's figure, ``make record``) is
+    copied byte for byte: quantizing it again would rewrite the file with no change."""
     from PIL import Image
     with Image.open(src) as im:
+        if im.format == "PNG" and im.mode == "P" and im.width <= width:
+            shutil.copyfile(src, dst)
+            return im.size
         rgba = im.convert("RGBA")
     if rgba.width > width:
         rgba = rgba.resize((width, max(1, round(rgba.height * width / rgba.width))),

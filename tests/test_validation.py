@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import ROOT, child_env
 from PIL import Image
@@ -396,3 +397,17 @@ def test_orientation_table():
                        "0.000 / 0.010 / 0.004", "2", "12.5", "21.4, 30.1"]
     assert len(rows) == 3
     assert any("made before it existed): beta." in ln for ln in L)
+
+
+def test_a_shrunk_figure_is_copied_unchanged(tmp_path):
+    """A figure already at most MAX_WIDTH px as a 256-colour PNG (a committed row's,
+    `make record`) is copied byte for byte; a full-colour one is shrunk and quantized."""
+    big = tmp_path / "big.png"
+    rng = np.random.default_rng(1)
+    Image.fromarray(rng.integers(0, 255, (300, 1800, 3), dtype=np.uint8)).save(big)
+    once, twice = tmp_path / "once.png", tmp_path / "twice.png"
+    assert validation.shrink_png(big, once) == (validation.MAX_WIDTH, 150)
+    with Image.open(once) as im:
+        assert im.mode == "P"
+    validation.shrink_png(once, twice)
+    assert twice.read_bytes() == once.read_bytes()
