@@ -141,8 +141,7 @@ def measure(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict:
     r = np.hypot(x - center[0], y - center[1])
     e = cracks.zone_edges(r_wall, r_out)
     zones = []
-    for k in range(3):
-        inside = (r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * h))
+    for k, inside in enumerate(cracks.zone_masks(r, h, r_wall, r_out)):
         area = np.pi * (e[k + 1] ** 2 - e[k] ** 2) * 1e6
         row = {"zone": k + 1, "r_mm": [e[k] * 1e3, e[k + 1] * 1e3],
                "failed_points": int(np.count_nonzero(failed & inside))}

@@ -58,6 +58,13 @@ def zone_edges(r_wall: float, r_out: float) -> np.ndarray:
     return r_wall + (r_out - r_wall) * np.arange(4) / 3.0
 
 
+def zone_masks(r, h, r_wall, r_out) -> list[np.ndarray]:
+    """Points of each crack-density zone (the last includes half a spacing beyond R_o)."""
+    e = zone_edges(r_wall, r_out)
+    return [(r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * h))
+            for k in range(3)]
+
+
 def per_point(value, x) -> np.ndarray:
     """A number or one per point, as one float per point of ``x``."""
     return np.broadcast_to(np.asarray(value, float), np.shape(x)).astype(float)
@@ -69,8 +76,7 @@ def crack_density(x, y, failed, center, dx, r_wall, r_out) -> list[dict]:
     h = per_point(dx, r)
     e = zone_edges(r_wall, r_out)
     out = []
-    for k in range(3):
-        inside = (r >= e[k]) & ((r < e[k + 1]) if k < 2 else (r <= e[k + 1] + 0.5 * h))
+    for k, inside in enumerate(zone_masks(r, h, r_wall, r_out)):
         n = int(np.count_nonzero(failed & inside))
         length = float(h[failed & inside].sum()) * 1e3
         area = np.pi * (e[k + 1] ** 2 - e[k] ** 2) * 1e6
