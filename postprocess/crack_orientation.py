@@ -44,6 +44,17 @@ count, radii (mean r) and lengths are reported.  A radial crack that crosses a
 ring makes the points about the crossing unresolved (not a line), so a ring
 crossed by k radial cracks is k arcs: the count is of arcs, the length is the
 measure of how much ring cracking there is.
+
+Failed rings.  A ring crack wider than about three points (a spall band) is
+unresolved by the local direction, and is found by the failed fraction in rings
+of width dx from the wall (:func:`postprocess.cracks.ring_index`, as the crushed
+zone's): beyond the crushed zone and the qualifying rings joined to it, each
+unbroken run of rings in which at least RING_FRACTION = 1/2 of the points have
+failed, and fewer than half of those are radial, is a failed ring: more than half
+its circumference cracked at that radius, and not by radial cracks, whose share of
+a ring is n w / (2 pi r) (n cracks of width w: 0.1-0.3 at the paper's geometry,
+but 1/2 at r = n w / pi close to the bore).  A ring one point wide can fall
+across two of the profile's rings at about 1/2 each; the ring arcs find it.
 """
 from __future__ import annotations
 
@@ -56,6 +67,7 @@ MIN_NEIGHBOURS = 4          # failed points within the horizon, the point includ
 RADIAL_DEG = 30.0
 CIRCUMFERENTIAL_DEG = 60.0
 RING_MIN_HORIZONS = 2.0
+RING_FRACTION = 0.5         # failed share of a ring of width dx for a failed ring
 CLASSES = ("radial", "oblique", "circumferential", "unresolved", "isolated")
 
 
@@ -132,6 +144,43 @@ def ring_arcs(x, y, circ, center, dx, horizon) -> list[dict]:
     return sorted(out, key=lambda a: a["r_mm"])
 
 
+def failed_rings(cls, x, y, center, dx, r_wall, r_out) -> list[dict]:
+    """Runs of rings beyond the crushed zone with >= RING_FRACTION failed, under half of
+    them radial (module docstring): each its radii [inner, outer] (mm) and its largest
+    failed fraction.  ``cls`` is :func:`classify`'s."""
+    k, nb, w = cracks.ring_index(x, y, center, dx, r_wall, r_out)
+    tot = np.bincount(k, minlength=nb)
+    bad = np.bincount(k[cls >= 0], minlength=nb)
+    radial = np.bincount(k[cls == 0], minlength=nb)
+    frac = np.where(tot > 0, bad / np.maximum(tot, 1), np.nan)
+    ring = (frac >= RING_FRACTION) & (radial < 0.5 * bad)
+    j = cracks.crushed_rings(frac)
+    while j < nb and (ring[j] or tot[j] == 0):
+        j += 1
+    out = []
+    while j < nb:
+        if not ring[j]:
+            j += 1
+            continue
+        a = j
+        while j < nb and (ring[j] or tot[j] == 0):
+            j += 1
+        out.append({"r_mm": [(r_wall + a * w) * 1e3, (r_wall + j * w) * 1e3],
+                    "peak_fraction": float(np.nanmax(frac[a:j]))})
+    return out
+
+
+def rings_text(section: dict) -> str:
+    """A report.json section's failed rings as text, "64.8–68.8 (0.99)" each (radii in
+    mm, the largest failed fraction); "—" for none, "not measured" for a report made
+    before them."""
+    rings = section.get("orientation", {}).get("failed_rings")
+    if rings is None:
+        return "not measured"
+    return ", ".join(f"{a['r_mm'][0]:.3g}–{a['r_mm'][1]:.3g} ({a['peak_fraction']:.2f})"
+                     for a in rings) or "—"
+
+
 def measure(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict:
     """Per-zone class counts and lengths, circumferential density and ring cracks."""
     x, y, failed = np.asarray(x, float), np.asarray(y, float), np.asarray(failed, bool)
@@ -153,8 +202,10 @@ def measure(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict:
         zones.append(row)
     rings = ring_arcs(x, y, cls == 2, center, h, link)
     return {"zones": zones, "ring_arcs": len(rings), "ring_arc_length_mm": float(sum(a["length_mm"] for a in rings)),
-            "rings": rings,
+            "rings": rings, "failed_rings": failed_rings(cls, x, y, center, h, r_wall, r_out),
             "rule": f"local direction of the failed points within the horizon (l2/l1 <= {LINEAR}, "
                     f"at least {MIN_NEIGHBOURS} points); radial < {RADIAL_DEG:g} deg < oblique < "
                     f"{CIRCUMFERENTIAL_DEG:g} deg < circumferential; a ring arc is a chain of "
-                    f"circumferential points at least {RING_MIN_HORIZONS:g} horizons long"}
+                    f"circumferential points at least {RING_MIN_HORIZONS:g} horizons long; a failed ring is "
+                    f"a run of rings of width dx beyond the crushed zone with at least "
+                    f"{RING_FRACTION:g} of their points failed, under half of those radial"}

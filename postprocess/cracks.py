@@ -137,19 +137,39 @@ def radial_cracks(x, y, failed, center, dx, r_wall, r_out, horizon=None) -> dict
             "link_mm": float(link.max()) * 1e3}
 
 
-def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
-    """Outer radius of the unbroken run of >= 90 % failed rings from the wall."""
+def ring_index(x, y, center, dx, r_wall, r_out) -> tuple[np.ndarray, int, float]:
+    """Each point's ring of width dx (the finest zone's) from the wall outward, the
+    number of rings and that dx."""
     r = np.hypot(np.asarray(x) - center[0], np.asarray(y) - center[1])
     dx = float(per_point(dx, r).min()) if len(r) else float(np.min(dx))
     nb = max(1, int(np.ceil((r_out - r_wall) / dx)))
-    k = np.clip(((r - r_wall) / dx).astype(int), 0, nb - 1)
+    return np.clip(((r - r_wall) / dx).astype(int), 0, nb - 1), nb, dx
+
+
+def ring_fractions(x, y, failed, center, dx, r_wall, r_out) -> tuple[np.ndarray, float]:
+    """Failed fraction in the rings of :func:`ring_index` (NaN where a ring holds no
+    point), and their width."""
+    k, nb, dx = ring_index(x, y, center, dx, r_wall, r_out)
     tot = np.bincount(k, minlength=nb)
-    bad = np.bincount(k[failed], minlength=nb)
-    frac = np.where(tot > 0, bad / np.maximum(tot, 1), 0.0)
+    bad = np.bincount(k[np.asarray(failed, bool)], minlength=nb)
+    return np.where(tot > 0, bad / np.maximum(tot, 1), np.nan), dx
+
+
+def crushed_rings(frac) -> int:
+    """Rings in the unbroken run of >= CRUSH_FRACTION from the wall (empty rings
+    count: a graded rock has gaps)."""
     run = 0
-    while run < nb and (tot[run] == 0 or frac[run] >= CRUSH_FRACTION):
+    while run < len(frac) and (np.isnan(frac[run]) or frac[run] >= CRUSH_FRACTION):
         run += 1
+    return run
+
+
+def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
+    """Outer radius of the unbroken run of >= 90 % failed rings from the wall."""
+    frac, dx = ring_fractions(x, y, failed, center, dx, r_wall, r_out)
+    run = crushed_rings(frac)
     rc = r_wall + run * dx
     return {"r_c_mm": rc * 1e3, "extent_mm": (rc - r_wall) * 1e3,
             "extent_borehole_radii": (rc - r_wall) / r_wall,
-            "failed_fraction_by_ring": frac[:max(run + 3, 1)].round(4).tolist()}
+            "failed_fraction_by_ring": np.nan_to_num(frac[:max(run + 3, 1)]).round(4).tolist()}
+

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from mpipd.output.writer import short_commit
 
-from .crack_orientation import CLASSES
+from .crack_orientation import CLASSES, RING_FRACTION, rings_text
 
 
 def _f(v, fmt=".3g"):
@@ -167,12 +167,16 @@ def _orientation(fr) -> list[str]:
             L.append(f"| {name} | {z['zone']} | {z['failed_points']} | "
                      + " | ".join(f"{z[c]['length_mm']:.4g}" for c in CLASSES)
                      + f" | {z['circumferential_density_mm_per_mm2']:.4f} |")
-    L += ["", "Ring arcs: length = mean radius × the angle covered.", "",
-          "| section | ring arcs | total length (mm) | radii (mm) |", "|---|---|---|---|"]
+    L += ["", "Ring arcs: length = mean radius × the angle covered.  Failed rings: rings of "
+          f"width dx beyond the crushed zone with at least {RING_FRACTION:g} of their points "
+          "failed, any band width (`postprocess/cracks.py`).", "",
+          "| section | ring arcs | total length (mm) | radii (mm) | failed rings (mm) |",
+          "|---|---|---|---|---|"]
     for name, s in fr["sections"].items():
         o = s["orientation"]
         radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"
-        L.append(f"| {name} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | {radii} |")
+        L.append(f"| {name} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | {radii} | "
+                 f"{rings_text(s)} |")
     return L + [""]
 
 

@@ -38,7 +38,7 @@ from pathlib import Path
 
 from .analysis import target_bounds
 from .case_coverage import coverage_table
-from .crack_orientation import CLASSES
+from .crack_orientation import CLASSES, RING_FRACTION, rings_text
 from .targets import BY_KEY, TARGETS, verdict
 
 MAX_WIDTH = 900
@@ -391,8 +391,7 @@ def orientation_table(runs) -> list[str]:
     def secs(r):
         fr = r["doc"].get("fracture", {})
         s = fr.get("sections", {}) if isinstance(fr, dict) else {}
-        return {n: v["orientation"] for n, v in s.items()
-                if isinstance(v, dict) and "orientation" in v}
+        return {n: v for n, v in s.items() if isinstance(v, dict) and "orientation" in v}
     have = [r for r in runs if secs(r)]
     if not have:
         return []
@@ -403,13 +402,17 @@ def orientation_table(runs) -> list[str]:
          "(> 60°) where they form a line; junctions, the crushed zone and wide bands are "
          "unresolved.  Shares are of the failed crack length in zones 2 and 3; the ring "
          "arcs are chains of circumferential points longer than two horizons (their count "
-         "splits at each radial crack that crosses them).", "",
+         "splits at each radial crack that crosses them).  The failed rings are rings of "
+         f"width dx beyond the crushed zone with at least {RING_FRACTION:g} of their points "
+         "failed, bands of any width (postprocess/cracks.py): radii in mm and, in brackets, "
+         "the largest failed fraction.", "",
          "| run | section | " + " | ".join(f"{c} (zones 2–3)" for c in CLASSES)
          + " | circumferential density zones 1 / 2 / 3 (mm/mm²) | ring arcs | "
-         "ring-arc length (mm) | ring-arc radii (mm) |",
-         "|---|---|" + "---|" * (len(CLASSES) + 4)]
+         "ring-arc length (mm) | ring-arc radii (mm) | failed rings (mm) |",
+         "|---|---|" + "---|" * (len(CLASSES) + 5)]
     for r in have:
-        for name, o in secs(r).items():
+        for name, sec in secs(r).items():
+            o = sec["orientation"]
             outer = o["zones"][1:]
             tot = sum(z[c]["length_mm"] for z in outer for c in CLASSES)
             share = [sum(z[c]["length_mm"] for z in outer) / tot if tot else float("nan")
@@ -420,7 +423,7 @@ def orientation_table(runs) -> list[str]:
             L.append(f"| {r['case']} | {_cell(name)} | "
                      + " | ".join(f"{v:.2f}" for v in share)
                      + f" | {dens} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | "
-                     f"{radii} |")
+                     f"{radii} | {rings_text(sec)} |")
     L.append("")
     without = [r["case"] for r in runs if r not in have]
     if without:

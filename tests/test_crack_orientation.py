@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from postprocess import crack_orientation as co
+from postprocess import cracks
 
 DX = 0.8e-3
 R_WALL, R_OUT = 3.2e-3, 72e-3
@@ -164,3 +165,52 @@ def test_no_failure():
     x, y = _section()
     m = co.measure(x, y, np.zeros(len(x), bool), (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)
     assert m["ring_arcs"] == 0 and all(z["failed_points"] == 0 for z in m["zones"])
+
+
+# Failed rings: rings of width dx beyond the crushed zone with at least half their
+# points failed, under half of those radial.
+
+def _rings(x, y, failed):
+    return co.measure(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, horizon=HORIZON)["failed_rings"]
+
+
+def test_a_wide_spall_band_is_a_failed_ring_and_the_crushed_zone_is_not():
+    x, y = _section()
+    r = np.hypot(x, y)
+    band = (r >= 60e-3) & (r < 64e-3)                 # five spacings wide
+    failed = (r < 10e-3) | band | _rays(x, y, np.arange(0, 360, 30))
+    rings = _rings(x, y, failed)
+    assert len(rings) == 1
+    lo, hi = rings[0]["r_mm"]
+    assert 59.2 - 1e-9 <= lo <= 60.0 + 1e-9 and 64.0 - 1e-9 <= hi <= 64.8 + 1e-9
+    assert rings[0]["peak_fraction"] == pytest.approx(1.0)
+    crushed = cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT)
+    assert 6.4 - 1e-9 <= crushed["extent_mm"] <= 7.2 + 1e-9        # 10 mm less the wall
+    # the band is five points wide: the local direction leaves most of it unresolved
+    m = co.measure(x, y, band, (0.0, 0.0), DX, R_WALL, R_OUT, horizon=HORIZON)
+    assert m["zones"][2]["unresolved"]["points"] > 0.5 * np.count_nonzero(band)
+
+
+def test_a_complete_ring_two_points_wide_is_a_failed_ring():
+    x, y = _section()
+    r = np.hypot(x, y)
+    rings = _rings(x, y, np.abs(r - 40e-3) < DX)
+    assert len(rings) == 1
+    assert rings[0]["r_mm"][0] <= 40.0 <= rings[0]["r_mm"][1]
+
+
+@pytest.mark.parametrize("what", ["rays", "arc", "random"])
+def test_radial_cracks_an_arc_and_random_failure_make_no_failed_ring(what):
+    x, y = _section()
+    r = np.hypot(x, y)
+    if what == "rays":              # 12 rays two points wide: 12 * 2 dx / (2 pi r) failed,
+        failed = _rays(x, y, np.arange(0, 360, 30))     # over 1/2 inside r = 6.1 mm
+        k, nb, w = cracks.ring_index(x, y, (0.0, 0.0), DX, R_WALL, R_OUT)
+        frac = np.bincount(k[failed], minlength=nb) / np.bincount(k, minlength=nb)
+        assert frac[2:8].max() >= co.RING_FRACTION
+    elif what == "arc":             # a band a third of the way round
+        th = np.arctan2(y, x)
+        failed = (r >= 40e-3) & (r < 44e-3) & (np.abs(th) < np.pi / 3)
+    else:
+        failed = np.random.default_rng(3).random(len(x)) < 0.3
+    assert _rings(x, y, failed) == []

@@ -387,15 +387,19 @@ def test_orientation_table():
     orient = {"zones": [zone(1, (0, 0, 0, 90, 0), 0.0), zone(2, (6, 2, 4, 7, 1), 0.01),
                         zone(3, (10, 2, 6, 1, 1), 0.004)],
               "ring_arcs": 2, "ring_arc_length_mm": 12.5,
-              "rings": [{"r_mm": 21.44, "length_mm": 6.0}, {"r_mm": 30.1, "length_mm": 6.5}]}
+              "rings": [{"r_mm": 21.44, "length_mm": 6.0}, {"r_mm": 30.1, "length_mm": 6.5}],
+              "failed_rings": [{"r_mm": [64.8, 68.8], "peak_fraction": 0.9887}]}
+    older = {k: v for k, v in orient.items() if k != "failed_rings"}
     runs = [{"case": "alpha", "doc": {"fracture": {"sections": {"mid": {"orientation": orient}}}}},
+            {"case": "old", "doc": {"fracture": {"sections": {"mid": {"orientation": older}}}}},
             {"case": "beta", "doc": {"fracture": {"sections": {"mid": {"zones": []}}}}}]
     L = validation.orientation_table(runs)
     rows = table("\n".join(L), "## Crack orientation")
     # zones 2-3: radial 16, oblique 4, circumferential 10, unresolved 8, isolated 2 of 40
     assert rows[2] == ["alpha", "mid", "0.40", "0.10", "0.25", "0.20", "0.05",
-                       "0.000 / 0.010 / 0.004", "2", "12.5", "21.4, 30.1"]
-    assert len(rows) == 3
+                       "0.000 / 0.010 / 0.004", "2", "12.5", "21.4, 30.1", "64.8–68.8 (0.99)"]
+    assert rows[3][-1] == "not measured"
+    assert len(rows) == 4
     assert any("made before it existed): beta." in ln for ln in L)
 
 
