@@ -339,7 +339,8 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             for k, v in lit.items()))
         off, n_gas = (team.sum(int(sim.gas.n_singular)), team.sum(len(sim.gas.gas_idx)))
         log(f"mpipd: gas points carrying no force at the end (no gas neighbourhood, "
-            f"mpipd.kernels.ul.well_posed): {off} of {n_gas}")
+            f"mpipd.kernels.ul.well_posed, or a family collapsing in a step, "
+            f"MAX_VOLUME_STRAIN): {off} of {n_gas}")
         log(f"mpipd: gas families searched {team.max(sim.gas.searches)} times in this "
             f"invocation, {team.max(sim.gas.search_seconds):.1f} s on the slowest rank "
             f"(mpipd.model.gas: Verlet skin tuned on the cost, {sim.gas.skin * 1e3:.3g} mm at the last search)")

@@ -594,6 +594,34 @@ def test_a_gas_point_acts_only_among_gas(where, acts):
     np.testing.assert_allclose(gd[c, :6], want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
 
 
+@pytest.mark.parametrize("s, acts", [(0.45, True), (-0.45, True), (0.55, False),
+                                     (-0.55, False), (4.7, False)])
+def test_a_family_collapsing_or_bursting_in_one_step_carries_no_force(s, acts):
+    """The affine field v = -a x gives tr L dt = -3 a dt = -s at the block's centre.
+    Within MAX_VOLUME_STRAIN = 0.5 the point acts (V_R = exp(-s), e from the
+    trapezoid's closed form); beyond it, compressed or expanded, it carries no force
+    and keeps its volume and energy.  At s = 4.7 (the four gas points that met on the
+    charge's axis in blast_paper:paper_coupling, issue 15) the closed form's
+    denominator V0 + w b / (2 V_R) is negative: the update would give e < 0."""
+    from mpipd.kernels.ul import MAX_VOLUME_STRAIN
+    assert MAX_VOLUME_STRAIN == 0.5
+    h, dt = 4.0e-4, 2.0e-8
+    a = s / (3.0 * dt)
+    gd, e, n_bad, gas_idx, c, x, _ = _lattice_update(lambda x: np.ones(len(x), bool), a, h)
+    k = int(np.flatnonzero(gas_idx == c)[0])
+    V0, w = h ** 3, 0.282
+    VR, b = math.exp(-s), -s * V0
+    if acts:
+        np.testing.assert_allclose(gd[c, 6] / V0, VR, rtol=1e-9)
+        assert e[k] != 7.38e9 and np.any(gd[c, :6] != 0.0)
+        assert (e[k] > 7.38e9) == (s > 0)          # compression heats, expansion cools
+        return
+    assert np.all(gd[c, :6] == 0.0) and gd[c, 6] == V0 and e[k] == 7.38e9
+    assert n_bad >= 1
+    if s > 1.5:
+        assert V0 + 0.5 * w * b / VR < 0.0
+
+
 # ------------------------------------------------------------------ gas-solid contact
 def _pair_gather(ly_now, xi, frac=0.9, kc=59.0e9, h_gas=4.0e-4, h_solid=3.0e-4, gas_j=False):
     """gas_gather on one pair, gas point 0 and point 1 (a solid, or gas if gas_j), no
