@@ -148,14 +148,14 @@ def failed_rings(cls, x, y, center, dx, r_wall, r_out) -> list[dict]:
     """Runs of rings beyond the crushed zone with >= RING_FRACTION failed, under half of
     them radial (module docstring): each its radii [inner, outer] (mm) and its largest
     failed fraction.  ``cls`` is :func:`classify`'s."""
-    k, nb, w = cracks.ring_index(x, y, center, dx, r_wall, r_out)
-    tot = np.bincount(k, minlength=nb)
+    frac, w = cracks.ring_fractions(x, y, cls >= 0, center, dx, r_wall, r_out)
+    k, nb, _ = cracks.ring_index(x, y, center, dx, r_wall, r_out)
     bad = np.bincount(k[cls >= 0], minlength=nb)
     radial = np.bincount(k[cls == 0], minlength=nb)
-    frac = np.where(tot > 0, bad / np.maximum(tot, 1), np.nan)
     ring = (frac >= RING_FRACTION) & (radial < 0.5 * bad)
+    empty = np.isnan(frac)
     j = cracks.crushed_rings(frac)
-    while j < nb and (ring[j] or tot[j] == 0):
+    while j < nb and (ring[j] or empty[j]):
         j += 1
     out = []
     while j < nb:
@@ -163,7 +163,7 @@ def failed_rings(cls, x, y, center, dx, r_wall, r_out) -> list[dict]:
             j += 1
             continue
         a = j
-        while j < nb and (ring[j] or tot[j] == 0):
+        while j < nb and (ring[j] or empty[j]):
             j += 1
         out.append({"r_mm": [(r_wall + a * w) * 1e3, (r_wall + j * w) * 1e3],
                     "peak_fraction": float(np.nanmax(frac[a:j]))})

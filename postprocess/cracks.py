@@ -172,4 +172,3 @@ def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
     return {"r_c_mm": rc * 1e3, "extent_mm": (rc - r_wall) * 1e3,
             "extent_borehole_radii": (rc - r_wall) / r_wall,
             "failed_fraction_by_ring": np.nan_to_num(frac[:max(run + 3, 1)]).round(4).tolist()}
-

@@ -169,7 +169,7 @@ def _orientation(fr) -> list[str]:
                      + f" | {z['circumferential_density_mm_per_mm2']:.4f} |")
     L += ["", "Ring arcs: length = mean radius × the angle covered.  Failed rings: rings of "
           f"width dx beyond the crushed zone with at least {RING_FRACTION:g} of their points "
-          "failed, any band width (`postprocess/cracks.py`).", "",
+          "failed, under half of those radial, any band width.", "",
           "| section | ring arcs | total length (mm) | radii (mm) | failed rings (mm) |",
           "|---|---|---|---|---|"]
     for name, s in fr["sections"].items():

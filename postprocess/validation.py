@@ -404,7 +404,7 @@ def orientation_table(runs) -> list[str]:
          "arcs are chains of circumferential points longer than two horizons (their count "
          "splits at each radial crack that crosses them).  The failed rings are rings of "
          f"width dx beyond the crushed zone with at least {RING_FRACTION:g} of their points "
-         "failed, bands of any width (postprocess/cracks.py): radii in mm and, in brackets, "
+         "failed, under half of those radial, bands of any width: radii in mm and, in brackets, "
          "the largest failed fraction.", "",
          "| run | section | " + " | ".join(f"{c} (zones 2–3)" for c in CLASSES)
          + " | circumferential density zones 1 / 2 / 3 (mm/mm²) | ring arcs | "
