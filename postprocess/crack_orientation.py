@@ -149,11 +149,9 @@ def failed_rings(cls, x, y, center, dx, r_wall, r_out) -> list[dict]:
     them radial (module docstring): each its radii [inner, outer] (mm) and its largest
     failed fraction.  ``cls`` is :func:`classify`'s."""
     frac, w = cracks.ring_fractions(x, y, cls >= 0, center, dx, r_wall, r_out)
-    k, nb, _ = cracks.ring_index(x, y, center, dx, r_wall, r_out)
-    bad = np.bincount(k[cls >= 0], minlength=nb)
-    radial = np.bincount(k[cls == 0], minlength=nb)
-    ring = (frac >= RING_FRACTION) & (radial < 0.5 * bad)
-    empty = np.isnan(frac)
+    radial, _ = cracks.ring_fractions(x, y, cls == 0, center, dx, r_wall, r_out)
+    ring = (frac >= RING_FRACTION) & (radial < 0.5 * frac)
+    empty, nb = np.isnan(frac), len(frac)
     j = cracks.crushed_rings(frac)
     while j < nb and (ring[j] or empty[j]):
         j += 1
