@@ -41,7 +41,7 @@ from .model.families import build_families
 from .model.gas import Gas
 from .model.interface import InterfaceCorrection
 from .model.interface import needed as interface_needed
-from .model.ledger import Energies, Ledger
+from .model.ledger import Energies, Ledger, impossible
 from .model.multirate import StepClasses
 from .output.peaks import Peaks
 from .output.probes import Probes
@@ -375,6 +375,23 @@ class Simulation:
                            f"first at gid {gid}, x = ({x[0]:.4g}, {x[1]:.4g}, {x[2]:.4g}) m; "
                            "compare dt with `mpipd check`")
 
+    def check_ledger(self, e):
+        """Raise :class:`Unstable` on every rank if the ledger reading ``e`` (global)
+        has |balance|, or a term that cannot be negative below minus, the scene's
+        ``solver.max_imbalance`` x its scale (mpipd.model.ledger.impossible): energy
+        that no term books, so the run's numbers from here on cannot be trusted.
+        A bound of 0 never raises."""
+        bound = self.scene.solver.max_imbalance
+        if not bound:
+            return
+        bad = ([f"balance {e.balance:+.3e}"] if abs(e.balance) > bound else []) + \
+            impossible(e, bound)
+        if bad:
+            raise Unstable(f"energy ledger broken at step {self.step_count} "
+                           f"(t = {self.t:.4e} s): {'; '.join(bad)}, beyond "
+                           f"solver.max_imbalance = {bound:g} of the ledger's scale "
+                           f"{e.scale:.4g} J; compare dt with `mpipd check`")
+
     def geometry_fields(self) -> dict:
         """Per-point fields of the reference state the run file keeps under
         /geometry (owned rows): the strength factors of a heterogeneous material."""
@@ -453,22 +470,31 @@ class Simulation:
                 raise RuntimeError(f"frame at step {self.step_count}, not a coarse-step "
                                    "boundary (the scene check keeps frames on them)")
             if frame or self.step_count % FINITE_CHECK_EVERY == 0:
-                try:
-                    self.check_finite()
-                except Unstable:
-                    if checkpointer is not None:
-                        checkpointer.write_final()
-                    raise
+                self._or_stop(self.check_finite, checkpointer)
             if frame:
-                writer.frame(self)
+                e = writer.frame(self)              # the frame that broke it is kept
+                self._or_stop(lambda: self.check_ledger(e), checkpointer)
             if not self.at_boundary:        # states of coarse classes are mid-step
                 continue
             if progress is not None:
-                progress(self, self.step_count - first, n_steps - first,
-                         _time.perf_counter() - t0)
+                e = progress(self, self.step_count - first, n_steps - first,
+                             _time.perf_counter() - t0)
+                if e is not None:
+                    self._or_stop(lambda: self.check_ledger(e), checkpointer)
             if checkpointer is not None and not last and checkpointer.after_step():
                 break
         return _time.perf_counter() - t0
+
+    @staticmethod
+    def _or_stop(check, checkpointer):
+        """Run a check; if it raises :class:`Unstable`, leave the state in
+        checkpoint_failed.h5 for a look first."""
+        try:
+            check()
+        except Unstable:
+            if checkpointer is not None:
+                checkpointer.write_final()
+            raise
 
 
 #: steps between NaN/Inf checks of the owned fields (also at every frame)
@@ -478,7 +504,9 @@ FINITE_CHECK_EVERY = 10
 class Progress:
     """One line on rank 0 every ``every`` steps (or about every ``seconds``): step,
     simulated time, wall time, ETA, throughput, failed points and energy.  Rank 0
-    decides when a line is due and tells the others, since the line needs global sums."""
+    decides when a line is due and tells the others, since the line needs global sums.
+    A call returns the ledger reading it printed (on every rank), or None when no
+    line was due."""
 
     def __init__(self, team, every: int = 0, seconds: float = 2.0, log=None):
         self.team = team
@@ -497,8 +525,11 @@ class Progress:
         self._last = wall
         failed = int(sim.failure_counts()[1:].sum()) if sim.failure is not None else 0
         e = sim.energies()
-        if not self.team.root:
-            return
+        if self.team.root:
+            self._line(sim, done, total, wall, failed, e)
+        return e
+
+    def _line(self, sim, done, total, wall, failed, e):
         rate = sim.n_bonds_global * done / max(wall, 1e-12)
         eta = wall / done * (total - done)
         self.log(f"step {sim.step_count:>7d}/{sim.step_count - done + total:<7d} "

@@ -112,3 +112,44 @@ def test_damping_books_the_kinetic_energy_it_removes():
     e = sim.energies()
     assert e.damping > 0.5 * e0.kinetic
     assert e.kinetic + e.damping == pytest.approx(e0.kinetic, rel=1e-13)
+
+
+def test_a_broken_ledger_stops_the_run_at_the_bound():
+    """Simulation.check_ledger: |balance| or a negative term beyond
+    solver.max_imbalance x scale raises; within it, or with the bound 0, not."""
+    from mpipd.model.ledger import Energies
+    from mpipd.solver import Unstable
+    scene, _ = sc.load("elastic_wave", ["parts.0.dx=0.004", "time.t_end=2e-6"])
+    sim = Simulation(scene, _team())
+    assert scene.solver.max_imbalance == 1e-2
+    sim.check_ledger(Energies(initial=1.0, kinetic=0.995))          # balance 5e-3
+    with pytest.raises(Unstable, match=r"balance \+2\.000e-02, beyond solver\.max_imbalance"):
+        sim.check_ledger(Energies(initial=1.0, kinetic=0.98))
+    # closes, but by a negative dissipation of 2 % of the scale
+    with pytest.raises(Unstable, match=r"energy ledger broken at step 0 .*plastic = -0\.02 J"):
+        sim.check_ledger(Energies(initial=1.0, kinetic=1.02, plastic=-0.02))
+    sim.check_ledger(Energies(initial=1.0, kinetic=1.005, plastic=-0.005))
+    off, _ = sc.load("elastic_wave", ["parts.0.dx=0.004", "time.t_end=2e-6",
+                                      "solver.max_imbalance=0"])
+    Simulation(off, _team()).check_ledger(Energies(initial=1.0, kinetic=0.5))
+
+
+def test_the_run_stops_at_the_first_frame_past_the_bound(tmp_path):
+    """A bound below the time-discretisation error (about 1e-8 here) stops the run
+    at its first frame after step 0, with exit status 3, the frame kept in the
+    run file and the state in checkpoint_failed.h5; the default bound lets the
+    same run finish."""
+    import h5py
+    from conftest import run_cli
+    args = ["run", "elastic_wave", "--quiet", "--set", "parts.0.dx=0.004",
+            "--set", "time.t_end=2e-6", "--set", "output.every=5"]
+    res = run_cli(args + ["--out", str(tmp_path / "a"), "--set", "solver.max_imbalance=1e-14"])
+    assert res.returncode == 3, res.stdout + res.stderr
+    msg = [ln for ln in res.stderr.splitlines() if ln.startswith("mpipd: error")]
+    assert len(msg) == 1 and "energy ledger broken at step 5 " in msg[0], msg
+    assert (tmp_path / "a" / "checkpoint_failed.h5").exists()
+    with h5py.File(tmp_path / "a" / "run.h5", "r") as f:
+        assert f.attrs["frames_written"] == 2
+        assert abs(f["energy/balance"][1]) > 1e-14
+    res = run_cli(args + ["--out", str(tmp_path / "b")])
+    assert res.returncode == 0, res.stdout + res.stderr

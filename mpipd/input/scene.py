@@ -10,7 +10,8 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
                   shape = { kind = "box" | "cylinder" | "annulus", ... },
                   influence = "quadratic" (default) | "constant" | "inverse",
                   jitter = 0.2, jitter_seed = 1 (lattice jitter, mpipd.input.geometry)
-    [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every
+    [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every,
+                  max_imbalance (the ledger bound that stops a run, default 1e-2), ...
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity" | "gaussian_velocity", ...
     [[boundaries]] kind = "fixed", region = { lo, hi }
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
@@ -320,7 +321,13 @@ class Solver:
     broke, so the next half kick uses the broken state's forces: velocity Verlet
     otherwise applies the pre-break force for one more half step, a first-order
     error at each breakage (it shows in the energy ledger's balance); it costs a
-    second force evaluation on such steps."""
+    second force evaluation on such steps.  ``max_imbalance`` stops a run (exit 3,
+    the state in checkpoint_failed.h5) at the first frame or progress line whose
+    energy ledger passes it: |balance|, or a term that cannot be negative below
+    -max_imbalance x the ledger's scale (mpipd.solver.Simulation.check_ledger);
+    0 never stops.  The report calls anything beyond 1e-3 an error
+    (mpipd.model.ledger.BALANCE_TOL); the default stops at ten times that, where
+    the run's numbers can no longer be booked."""
     hourglass: float = 0.01
     progress_every: int = 0           # steps between progress lines; 0 = about every 2 s
     contact: bool = False
@@ -328,9 +335,10 @@ class Solver:
     viscosity: Viscosity | None = None
     interface_correction: bool = True
     refresh_after_break: bool = False
+    max_imbalance: float = 1e-2
 
     def check(self, path):
-        non_negative(self, path, "hourglass", "progress_every", "damping")
+        non_negative(self, path, "hourglass", "progress_every", "damping", "max_imbalance")
 
 
 @dataclass(frozen=True)

@@ -214,13 +214,16 @@ class Writer:
             dset[sel] = data
 
     def frame(self, sim):
+        """Write the current state as the next frame; returns the ledger reading
+        it recorded (mpipd.model.ledger.Energies, global)."""
         if self.frame_no >= self.n_frames:
             raise RuntimeError("more frames than the file was sized for")
         k = self.frame_no
         g0, g1 = sim.gid_range
         for name, d in self.dsets.items():
             self._write(d, np.s_[k, g0:g1], field_values(sim, name))
-        values = {"t": sim.t, **sim.energies().as_dict()}
+        e = sim.energies()
+        values = {"t": sim.t, **e.as_dict()}
         # small per-frame scalars: every rank writes the same value collectively
         self._write(self.time, np.s_[k:k + 1], np.array([sim.t]))
         for key, d in self.energy.items():
@@ -232,6 +235,7 @@ class Writer:
             sim.probes.flush()
         self.f.attrs["frames_written"] = self.frame_no
         self.f.flush()                  # a crash loses at most the frames since this one
+        return e
 
     def _broken_bonds(self, sim, k: int):
         """Append frame k's broken bonds to /bonds/broken (each rank its owned
