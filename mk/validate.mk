@@ -58,6 +58,8 @@
 # blast_paper_case4 (a7ab5a3 to step 2540, then resumed at ed91c1a, the same mpipd/; notes §34): the same with case4,
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_case4/checkpoint.h5
 # blast_paper_paper_coupling (c008304, after the gas's volume-strain bound, notes §34): the same with paper_coupling
+# blast_paper_rockmass (61f49a6 to step 2240, then resumed at 2bada73; the mpipd/ of both is c008304's, notes §35):
+#   the same with rockmass, then mpirun -n 2 mpipd run --restart runs/blast_paper_rockmass/checkpoint.h5
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -65,7 +67,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_row_sum_part/run.h5 runs/blast_paper_window0/run.h5 runs/blast_paper_kernels/run.h5 \
     runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 runs/blast_paper_case1/run.h5 runs/blast_paper_case2/run.h5 \
     runs/blast_paper_case3/run.h5 runs/blast_paper_case4/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
-    runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 \
+    runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
