@@ -103,6 +103,20 @@ sensitivity: install
 	    --title "Table 3 at the paper's geometry: the base scene (Table 1) and each case run so far; \`make sensitivity\`" \
 	    table1=$(SENS_BASE) $(foreach d,$(SENS_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
 
+# `make model-cases`: the named cases at the paper's geometry that change the model rather
+# than Table 3's parameters (the rock mass, the paper's gas coupling, the gas contact, the
+# seamless band) and the base scene run again at a later commit, each row that exists
+# beside the base scene's (SENS_BASE) with its difference from it, in
+# docs/model_cases_blast_paper.md (the same reader as `make sensitivity`).
+MODEL_ROWS ?= $(wildcard $(addprefix docs/validation/blast_paper_,rerun rockmass paper_coupling gas_contact seamless))
+MODEL_OUT ?= docs/model_cases_blast_paper.md
+.PHONY: model-cases
+model-cases: install
+	@test -n "$(strip $(MODEL_ROWS))" || { echo "no row of MODEL_ROWS in docs/validation/ to set beside the base: run one and make validate with it first" >&2; exit 2; }
+	$(PY) benchmarks/multirate_compare.py --out $(MODEL_OUT) \
+	    --title "The model's own cases at the paper's geometry beside the base scene; \`make model-cases\`" \
+	    base=$(SENS_BASE) $(foreach d,$(MODEL_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+
 # `make record`: the same record on a machine that lacks some of VALIDATE_RUNS' run files
 # (a new machine keeps none): each row from its run's report or run file when it is here,
 # else from the row's committed folder docs/validation/<case>/ at HEAD, extracted into
