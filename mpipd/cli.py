@@ -295,8 +295,15 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     if sim.step_count == n_steps:
         checkpointer.at_end()
     if sim.step_count < n_steps:
-        log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; checkpoint "
-            f"{checkpointer.written}; continue with `mpipd run --restart {checkpointer.written}`")
+        # what this invocation saw of the stable step: the next one counts afresh
+        n_switched = team.sum(sim.corr.floor_switches)
+        over = sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+        log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; {n_switched} stable-step "
+            "switch(es) from the correspondence force in this invocation "
+            f"(mpipd.model.correspondence.stable_floor); checkpoint {checkpointer.written}; "
+            f"continue with `mpipd run --restart {checkpointer.written}`")
+        if over:
+            log(f"mpipd: warning: {over}", error=True)
         return 0
     n_spring = sim.spring_points()
     n_floor = team.sum(sim.corr.count_floor())

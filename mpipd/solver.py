@@ -390,7 +390,9 @@ class Simulation:
             raise Unstable(f"energy ledger broken at step {self.step_count} "
                            f"(t = {self.t:.4e} s): {'; '.join(bad)}, beyond "
                            f"solver.max_imbalance = {bound:g} of the ledger's scale "
-                           f"{e.scale:.4g} J; compare dt with `mpipd check`")
+                           f"{e.scale:.4g} J; compare dt with `mpipd check`; where bonds "
+                           "break, solver.refresh_after_break = true removes velocity "
+                           "Verlet's breakage error (README, the energy ledger)")
 
     def geometry_fields(self) -> dict:
         """Per-point fields of the reference state the run file keeps under

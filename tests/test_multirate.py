@@ -636,8 +636,10 @@ def test_the_tension_check_of_the_updated_points_alone_is_the_check_of_all():
     (Correspondence.check_tension): on a fracturing granite_ring with classes from the
     state, the same failures, positions and velocities bit for bit as the check of
     every point at every step."""
+    # without the scene's force refresh after breakage: 8 points fail in tension by
+    # 4 us with it, too few to compare
     over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=4e-6", "output.every=40",
-            'time.multirate={max_ratio=4, safety=0.9}']
+            'time.multirate={max_ratio=4, safety=0.9}', "solver.refresh_after_break=false"]
     out = []
     for every in (False, True):
         scene, _ = sc.load("granite_ring", over)

@@ -42,6 +42,8 @@ def test_restart_same_and_different_rank_count(tmp_path, reference):
     res = run_cli(["run", "granite_ring", "--out", str(a), "--stop-after", "230", *ARGS], ranks=2)
     assert res.returncode == 0, res.stderr
     assert "stopped at step 230" in res.stdout and (a / "checkpoint.h5").exists()
+    # a stopped invocation reports its stable-step switches too (none in this ring)
+    assert "stopped at step 230 of 240; 0 stable-step switch(es)" in res.stdout
     shutil.copytree(a, tmp_path / "b")
     for d, n in ((a, 2), (tmp_path / "b", 3)):
         res = run_cli(["run", "--restart", str(d / "checkpoint.h5"), "--quiet"], ranks=n)
