@@ -60,6 +60,9 @@
 # blast_paper_paper_coupling (c008304, after the gas's volume-strain bound, notes §34): the same with paper_coupling
 # blast_paper_rockmass (61f49a6 to step 2240, then resumed at 2bada73; the mpipd/ of both is c008304's, notes §35):
 #   the same with rockmass, then mpirun -n 2 mpipd run --restart runs/blast_paper_rockmass/checkpoint.h5
+# blast_paper_rerun (1e1fe43, whose physics is c008304's; notes §36): the base scene again after the stable-step
+#   fallback and the gas's volume-strain bound: mpirun -n 2 mpipd run blast_paper --set output.every=200
+#   --set output.checkpoint_every=500 --out runs/blast_paper_rerun
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -68,6 +71,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 runs/blast_paper_case1/run.h5 runs/blast_paper_case2/run.h5 \
     runs/blast_paper_case3/run.h5 runs/blast_paper_case4/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
+    runs/blast_paper_rerun/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
@@ -89,12 +93,13 @@ diagnoses: install
 
 # `make sensitivity`: Table 3's cases (Fig. 22) at the paper's geometry, from the rows of
 # the record: the base scene (SENS_BASE, the default rule's full run) beside every case
-# row docs/validation/blast_paper_case<k>/ that exists, each with its difference from the
+# row docs/validation/blast_paper_case<k>/ that exists, and the base run again at a later
+# commit (blast_paper_rerun, notes §36: the base's own shift), each with its difference from the
 # base, in docs/sensitivity_blast_paper.md (benchmarks/multirate_compare.py reads each
 # row's report.json). A case row is made by its run (about an hour on 2 ranks; the
 # commands are above), its report and `make validate` with it in VALIDATE_RUNS.
 SENS_BASE ?= docs/validation/blast_paper_index
-SENS_ROWS ?= $(sort $(wildcard docs/validation/blast_paper_case[1-6]))
+SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6]))
 SENS_OUT ?= docs/sensitivity_blast_paper.md
 .PHONY: sensitivity
 sensitivity: install
