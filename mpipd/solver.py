@@ -377,10 +377,10 @@ class Simulation:
 
     def check_ledger(self, e):
         """Raise :class:`Unstable` on every rank if the ledger reading ``e`` (global)
-        has |balance|, or a term that cannot be negative below minus, the scene's
-        ``solver.max_imbalance`` x its scale (mpipd.model.ledger.impossible): energy
-        that no term books, so the run's numbers from here on cannot be trusted.
-        A bound of 0 never raises."""
+        has |balance| > b, or a term that cannot be negative below -b x its scale
+        (mpipd.model.ledger.impossible), b = the scene's ``solver.max_imbalance``:
+        energy that no term books, so the run's numbers from here on cannot be
+        trusted.  b = 0 never raises."""
         bound = self.scene.solver.max_imbalance
         if not bound:
             return
