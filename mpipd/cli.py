@@ -232,6 +232,12 @@ def _on_root(team, fn, *args):
         raise err
 
 
+def _over_dt(sim, team, scene) -> str | None:
+    """The multi-rate line on points whose stable step fell below dt in this
+    invocation (collective; None if none did, or single-rate)."""
+    return sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+
+
 def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
             dt_stable, run_id, resume) -> int:
     from .output import checkpoint as ck
@@ -287,7 +293,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
                        checkpointer=checkpointer)
     except Unstable as e:
         writer.close()
-        over = sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+        over = _over_dt(sim, team, scene)
         log(f"mpipd: error: {e}; state saved in {checkpointer.written}"
             + (f"; {over}" if over else ""), error=True)
         return EXIT_UNSTABLE
@@ -297,7 +303,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     if sim.step_count < n_steps:
         # what this invocation saw of the stable step: the next one counts afresh
         n_switched = team.sum(sim.corr.floor_switches)
-        over = sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+        over = _over_dt(sim, team, scene)
         log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; {n_switched} stable-step "
             "switch(es) from the correspondence force in this invocation "
             f"(mpipd.model.correspondence.stable_floor); checkpoint {checkpointer.written}; "
@@ -323,7 +329,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             + f"; {broken} bonds broken")
     if sim.classes.enabled:
         log("mpipd: " + sim.classes.summary(team))
-        over = sim.classes.over_line(team, list(scene.materials))
+        over = _over_dt(sim, team, scene)
         if over:
             log(f"mpipd: warning: {over}", error=True)
     from .model.ledger import impossible
