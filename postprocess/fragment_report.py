@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from mpipd.input.scene import parse
+from mpipd.output.pairs import rows_between
 from mpipd.output.probes import part_matches
 from mpipd.parallel.team import Team
 
@@ -80,9 +81,7 @@ def make_fragments(run_path, out, comm, frame: int = -1, parts=None, min_points:
         lo, hi = int(p.gid.min()), int(p.gid.max())
         off = f["bonds/offsets"]
         a, b = int(off[k]), int(off[k + 1])
-        col = f["bonds/broken"][a:b, 0] if b > a else np.empty(0, np.int64)
-        s0, s1 = np.searchsorted(col, lo, "left"), np.searchsorted(col, hi, "right")
-        pairs = f["bonds/broken"][a + s0:a + s1] if s1 > s0 else np.empty((0, 2), np.int64)
+        pairs = rows_between(f["bonds/broken"], a, b, lo, hi + 1)
         damage = None
         if damage_threshold is not None:
             damage = np.zeros(p.n_local)
@@ -93,7 +92,9 @@ def make_fragments(run_path, out, comm, frame: int = -1, parts=None, min_points:
         if moved:
             x += f["fields/u"][k, g0:g1]
         t = float(f["time"][k])
-    frag.mark_broken(pairs, damage, damage_threshold)
+    if team.max(frag.mark_broken(pairs, damage, damage_threshold)):
+        raise FragmentInputError(f"{run_path}: broken bonds in frame {k} that are not bonds "
+                                 "of the run's scene")
     label = frag.labels()
     stats = frag.statistics(label, x)
     section = _section(frag, label, z)

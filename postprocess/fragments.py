@@ -173,17 +173,15 @@ class Fragments:
     def mark_broken(self, pairs: np.ndarray, damage=None, threshold=None):
         """Set the families' broken flags from the frame's (gid_lo, gid_hi) pairs (those
         this rank may hold), and by the damage rule if ``threshold`` is given
-        (``damage``: owned + ghost values)."""
+        (``damage``: owned + ghost values).  Returns the number of pairs that are
+        not bonds of the families (0 for the run's own file)."""
         p, fam = self.points, self.families
-        N = self.table.n_points
-        rows = np.repeat(np.arange(p.n_owned), np.diff(fam.offsets))
-        gi, gj = p.gid[rows], p.gid[fam.nbr]
-        key = np.minimum(gi, gj) * N + np.maximum(gi, gj)
-        want = np.sort(pairs[:, 0] * N + pairs[:, 1]) if len(pairs) else np.empty(0, np.int64)
-        broken = np.isin(key, want)
+        missing = fam.set_broken(p.gid, pairs, both=True)
         if threshold is not None:
-            broken |= (damage[rows] > threshold) & (damage[fam.nbr] > threshold)
-        fam.broken[:] = broken.astype(np.uint8)
+            rows = np.repeat(np.arange(p.n_owned), np.diff(fam.offsets))
+            fam.broken |= ((damage[rows] > threshold)
+                           & (damage[fam.nbr] > threshold)).astype(np.uint8)
+        return missing
 
     def labels(self) -> np.ndarray:
         """The fragment label (smallest gid) of every owned point; -1 where not analysed."""

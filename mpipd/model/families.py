@@ -42,14 +42,24 @@ class Families:
         """(gid_i, gid_j) of the broken bonds of the owned points' families, in family
         order (gid_i ascending, then gid_j): every directed copy, or with ``lower``
         only those with gid_i < gid_j — each bond once over all ranks, since the
-        owner of its lower-gid end holds that copy."""
-        rows = np.repeat(np.arange(len(self.offsets) - 1), np.diff(self.offsets))
-        b = self.broken.astype(bool)
-        gi, gj = gid[rows[b]], gid[self.nbr[b]]
-        if lower:
-            keep = gi < gj
-            gi, gj = gi[keep], gj[keep]
-        return np.stack([gi, gj], axis=1).astype(np.int64)
+        owner of its lower-gid end holds that copy.  No per-bond temporary: the
+        pairs themselves are the only allocation (_broken_pairs)."""
+        return _broken_pairs(self.offsets, self.nbr, self.broken, gid, lower)
+
+    def set_broken(self, gid: np.ndarray, pairs: np.ndarray, both: bool = False) -> int:
+        """Set ``broken`` from (gid_i, gid_j) pairs, every other bond intact: the bond of
+        owned point gid_i to gid_j, and with ``both`` also that of owned gid_j to gid_i
+        (pairs given once, as broken_pairs(lower=True) writes them).  Pairs with no
+        owned end are skipped.  Returns the number of pairs whose owned end has no
+        such neighbour (0 when the pairs come from the same families).  By bisection
+        in the gid-sorted families, O(pairs log k), no per-bond temporary
+        (_mark_pairs): a restart at 283 M bonds needs no more memory than the run."""
+        n = len(self.offsets) - 1
+        owned = np.ascontiguousarray(gid[:n], dtype=np.int64)
+        order = np.argsort(owned, kind="stable")
+        return int(_mark_pairs(self.offsets, self.nbr, gid, owned[order], order,
+                               np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2),
+                               both, self.broken))
 
     def register(self, state):
         """The CSR arrays in the State (owner "families"; ``broken`` is written by
@@ -78,6 +88,63 @@ def _csr_by_row(i, j, gid, n_rows):
     for r in range(n_rows):
         sort_row_by_gid(nbr, start[r], start[r + 1], gid)
     return counts, nbr
+
+
+@numba.njit(cache=True)
+def _broken_pairs(offsets, nbr, broken, gid, lower):
+    """The (gid_i, gid_j) rows of Families.broken_pairs: a counting pass, then a fill."""
+    n = offsets.shape[0] - 1
+    m = 0
+    for i in range(n):
+        for k in range(offsets[i], offsets[i + 1]):
+            if broken[k] and (not lower or gid[i] < gid[nbr[k]]):
+                m += 1
+    out = np.empty((m, 2), np.int64)
+    m = 0
+    for i in range(n):
+        for k in range(offsets[i], offsets[i + 1]):
+            if broken[k] and (not lower or gid[i] < gid[nbr[k]]):
+                out[m, 0] = gid[i]
+                out[m, 1] = gid[nbr[k]]
+                m += 1
+    return out
+
+
+@numba.njit(cache=True)
+def _mark_one(offsets, nbr, gid, sorted_owned, order, gi, gj, broken):
+    """Mark the bond of owned point gid ``gi`` to gid ``gj``: 1 marked, 0 no owned
+    point gi, -1 owned but no such neighbour.  Rows by bisection in the sorted owned
+    gids, the neighbour by bisection in the row (families are sorted by gid)."""
+    r = np.searchsorted(sorted_owned, gi)
+    if r == sorted_owned.shape[0] or sorted_owned[r] != gi:
+        return 0
+    i = order[r]
+    lo, hi = offsets[i], offsets[i + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if gid[nbr[mid]] < gj:
+            lo = mid + 1
+        else:
+            hi = mid
+    if lo < offsets[i + 1] and gid[nbr[lo]] == gj:
+        broken[lo] = 1
+        return 1
+    return -1
+
+
+@numba.njit(cache=True)
+def _mark_pairs(offsets, nbr, gid, sorted_owned, order, pairs, both, broken):
+    """Families.set_broken: clear ``broken``, mark every pair; count the misses."""
+    broken[:] = 0
+    missing = 0
+    for p in range(pairs.shape[0]):
+        if _mark_one(offsets, nbr, gid, sorted_owned, order, pairs[p, 0], pairs[p, 1],
+                     broken) < 0:
+            missing += 1
+        if both and _mark_one(offsets, nbr, gid, sorted_owned, order, pairs[p, 1],
+                              pairs[p, 0], broken) < 0:
+            missing += 1
+    return missing
 
 
 def build_families(x: np.ndarray, gid: np.ndarray, horizon: np.ndarray, n_owned: int,

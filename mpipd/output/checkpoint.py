@@ -36,6 +36,7 @@ import numpy as np
 
 from .. import __version__
 from ..state import LAST, REBUILT, STATE
+from .pairs import rows_between
 
 FORMAT = "mpipd-checkpoint-1"
 
@@ -252,10 +253,7 @@ def restore(sim, path) -> None:
             if f"points/{name}" not in f:
                 raise CheckpointError(f"{path}: checkpoint lacks points/{name}")
             data[name] = f[f"points/{name}"][g0:g1]
-        broken = f["broken"]
-        gi = broken[:, 0] if len(broken) else np.empty(0, np.int64)
-        lo, hi = np.searchsorted(gi, g0, "left"), np.searchsorted(gi, g1, "left")
-        mine = broken[lo:hi] if hi > lo else np.empty((0, 2), np.int64)
+        mine = rows_between(f["broken"], 0, len(f["broken"]), g0, g1)
         step, t = int(f.attrs["step"]), float(f.attrs["t"])
         scalars = {}
         for name in sim.state.scalars:
@@ -271,16 +269,12 @@ def restore(sim, path) -> None:
         raise CheckpointError(f"{path}: non-finite values in " + (", ".join(bad) or "attributes")
                               + " (a corrupted checkpoint, or one written by a blow-up)")
     st = sim.state
-    n = sim.points.n_owned
     for fld in st.checkpointed(STATE):                  # 1. the state
         fld.load(data[fld.name])
-    # broken bonds by gid pair
-    fam, gid = sim.families, sim.points.gid
-    if len(mine):
-        rows = np.repeat(np.arange(n), np.diff(fam.offsets))
-        key = gid[rows] * sim.n_global + gid[fam.nbr]
-        want = np.sort(mine[:, 0] * sim.n_global + mine[:, 1])
-        fam.broken[:] = np.isin(key, want).astype(np.uint8)
+    missing = sim.families.set_broken(sim.points.gid, mine)   # broken bonds by gid pair
+    if team.max(missing):
+        raise CheckpointError(f"{path}: broken bonds that are not bonds of this scene's "
+                              "families (a checkpoint of another model)")
     sim.step_count, sim.t = step, t
     for name, s in st.scalars.items():                  # global sums: held once, on rank 0
         v = scalars[name]
