@@ -107,6 +107,17 @@ def cross_pairs(offsets, nbr, broken, keep, n_owned, root_gid, ghost_root):
     return out[:n]
 
 
+@numba.njit(cache=True)
+def _break_damaged(offsets, nbr, damage, threshold, broken):
+    """The damage rule: a bond whose two ends both have damage above ``threshold``
+    counts as broken (no per-bond temporary)."""
+    for i in range(offsets.shape[0] - 1):
+        if damage[i] > threshold:
+            for k in range(offsets[i], offsets[i + 1]):
+                if damage[nbr[k]] > threshold:
+                    broken[k] = 1
+
+
 def merge_roots(pairs: np.ndarray) -> dict:
     """Union-find over (root, root) pairs: every root -> the smallest root joined to it."""
     parent = {}
@@ -178,9 +189,7 @@ class Fragments:
         p, fam = self.points, self.families
         missing = fam.set_broken(p.gid, pairs, both=True)
         if threshold is not None:
-            rows = np.repeat(np.arange(p.n_owned), np.diff(fam.offsets))
-            fam.broken |= ((damage[rows] > threshold)
-                           & (damage[fam.nbr] > threshold)).astype(np.uint8)
+            _break_damaged(fam.offsets, fam.nbr, damage, threshold, fam.broken)
         return missing
 
     def labels(self) -> np.ndarray:

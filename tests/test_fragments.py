@@ -149,3 +149,21 @@ def test_bad_input_is_one_line(tmp_path, cut_block):
         lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
         assert res.returncode == 2 and len(lines) == 1 and needle in lines[0], res.stderr
         assert not (tmp_path / "f").exists()
+
+
+def test_damage_rule_breaks_bonds_between_two_damaged_points():
+    """--damage-threshold: a bond counts as broken where both ends exceed it; bonds
+    already broken stay broken (checked against a loop over the hand-built bonds)."""
+    from mpipd.model.families import build_families
+    from postprocess.fragments import _break_damaged
+    rng = np.random.default_rng(5)
+    x = rng.random((120, 3))
+    fam = build_families(x, np.arange(120), np.full(120, 0.3), 90)
+    damage = rng.random(120)
+    before = (rng.random(fam.n_bonds) < 0.1).astype(np.uint8)
+    fam.broken[:] = before
+    _break_damaged(fam.offsets, fam.nbr, damage, 0.6, fam.broken)
+    for i in range(90):
+        for k in range(fam.offsets[i], fam.offsets[i + 1]):
+            j = fam.nbr[k]
+            assert fam.broken[k] == (before[k] or (damage[i] > 0.6 and damage[j] > 0.6))
