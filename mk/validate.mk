@@ -63,6 +63,10 @@
 # blast_paper_rerun (1e1fe43, whose physics is c008304's; notes §36): the base scene again after the stable-step
 #   fallback and the gas's volume-strain bound: mpirun -n 2 mpipd run blast_paper --set output.every=200
 #   --set output.checkpoint_every=500 --out runs/blast_paper_rerun
+# blast_paper_dx0.7 (a6720de to step 1840, then resumed at c54853e, whose mpipd/ differs only in how broken bonds become gid pairs and back and in a log line's helper (0ae01ec);
+#   the physics of both is c008304's, notes §37): mpirun -n 2 mpipd run blast_paper:dx0.7
+#   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_dx0.7,
+#   then mpirun -n 2 mpipd run --restart runs/blast_paper_dx0.7/checkpoint.h5
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -71,7 +75,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_single_rate/run.h5 runs/blast_paper_index/run.h5 runs/blast_paper_case1/run.h5 runs/blast_paper_case2/run.h5 \
     runs/blast_paper_case3/run.h5 runs/blast_paper_case4/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
-    runs/blast_paper_rerun/run.h5 \
+    runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
@@ -121,6 +125,22 @@ model-cases: install
 	$(PY) benchmarks/multirate_compare.py --out $(MODEL_OUT) \
 	    --title "The model's own cases at the paper's geometry beside the base scene; \`make model-cases\`" \
 	    base=$(SENS_BASE) $(foreach d,$(MODEL_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+
+# `make resolution`: the discretisation study at the paper's geometry (the paper's §3.4):
+# the rock at 0.8 mm (RES_BASE: the base scene's run on the physics of dx0.7's run,
+# blast_paper_rerun) beside every other rock dx with a row, coarse to fine, each with its
+# difference from the 0.8 mm row, in docs/resolution_blast_paper.md (the same reader as
+# `make sensitivity`). The 1.2 and 1.0 mm rows predate the stable-step fallback and the
+# gas's bound (their commits are in the table): notes §37 reads them with §36.
+RES_BASE ?= docs/validation/blast_paper_rerun
+RES_ROWS ?= $(wildcard $(addprefix docs/validation/blast_paper_,dx1.2_contained dx1.0 dx0.7))
+RES_OUT ?= docs/resolution_blast_paper.md
+.PHONY: resolution
+resolution: install
+	@test -n "$(strip $(RES_ROWS))" || { echo "no other rock dx has a row in docs/validation/ to set beside the 0.8 mm row: run one and make validate with it first" >&2; exit 2; }
+	$(PY) benchmarks/multirate_compare.py --out $(RES_OUT) \
+	    --title "The rock's dx at the paper's geometry, beside the 0.8 mm scene; \`make resolution\`" \
+	    dx0.8=$(RES_BASE) $(foreach d,$(RES_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
 
 # `make record`: the same record on a machine that lacks some of VALIDATE_RUNS' run files
 # (a new machine keeps none): each row from its run's report or run file when it is here,
