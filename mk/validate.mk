@@ -95,52 +95,51 @@ diagnoses: install
 	$(PY) benchmarks/diagnoses/wave_speed.py --study --mpirun "$(MPIRUN)" \
 	    --out docs/diagnoses/wave_ring_elastic.md
 
+# compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
+# `make sensitivity`, `make model-cases` and `make resolution` — the base row beside every
+# row dir in ROWS (labelled by its name after blast_paper_), each with its difference from
+# the base, written to OUT by benchmarks/multirate_compare.py from the rows' report.json.
+# No row: one line naming WHAT is missing, exit status 2.
+define compare_rows
+	@test -n "$(strip $(4))" || { echo "no $(5) in docs/validation/ to set beside the base: run one and make validate with it first" >&2; exit 2; }
+	$(PY) benchmarks/multirate_compare.py --out $(1) --title "$(2)" \
+	    $(3) $(foreach d,$(4),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+endef
+
 # `make sensitivity`: Table 3's cases (Fig. 22) at the paper's geometry, from the rows of
 # the record: the base scene (SENS_BASE, the default rule's full run) beside every case
 # row docs/validation/blast_paper_case<k>/ that exists, and the base run again at a later
-# commit (blast_paper_rerun, notes §36: the base's own shift), each with its difference from the
-# base, in docs/sensitivity_blast_paper.md (benchmarks/multirate_compare.py reads each
-# row's report.json). A case row is made by its run (about an hour on 2 ranks; the
-# commands are above), its report and `make validate` with it in VALIDATE_RUNS.
+# commit (blast_paper_rerun, notes §36: the base's own shift), in
+# docs/sensitivity_blast_paper.md. A case row is made by its run (about an hour on 2
+# ranks; the commands are above), its report and `make validate` with it in VALIDATE_RUNS.
 SENS_BASE ?= docs/validation/blast_paper_index
 SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6]))
 SENS_OUT ?= docs/sensitivity_blast_paper.md
 .PHONY: sensitivity
 sensitivity: install
-	@test -n "$(strip $(SENS_ROWS))" || { echo "no case row (docs/validation/blast_paper_case<k>/) to set beside the base: run a case and make validate with it first" >&2; exit 2; }
-	$(PY) benchmarks/multirate_compare.py --out $(SENS_OUT) \
-	    --title "Table 3 at the paper's geometry: the base scene (Table 1) and each case run so far; \`make sensitivity\`" \
-	    table1=$(SENS_BASE) $(foreach d,$(SENS_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+	$(call compare_rows,$(SENS_OUT),Table 3 at the paper's geometry: the base scene (Table 1) and each case run so far; \`make sensitivity\`,table1=$(SENS_BASE),$(SENS_ROWS),case row (docs/validation/blast_paper_case<k>/))
 
 # `make model-cases`: the named cases at the paper's geometry that change the model rather
 # than Table 3's parameters (the rock mass, the paper's gas coupling, the gas contact, the
 # seamless band) and the base scene run again at a later commit, each row that exists
-# beside the base scene's (SENS_BASE) with its difference from it, in
-# docs/model_cases_blast_paper.md (the same reader as `make sensitivity`).
+# beside the base scene's (SENS_BASE), in docs/model_cases_blast_paper.md.
 MODEL_ROWS ?= $(wildcard $(addprefix docs/validation/blast_paper_,rerun rockmass paper_coupling gas_contact seamless))
 MODEL_OUT ?= docs/model_cases_blast_paper.md
 .PHONY: model-cases
 model-cases: install
-	@test -n "$(strip $(MODEL_ROWS))" || { echo "no row of MODEL_ROWS in docs/validation/ to set beside the base: run one and make validate with it first" >&2; exit 2; }
-	$(PY) benchmarks/multirate_compare.py --out $(MODEL_OUT) \
-	    --title "The model's own cases at the paper's geometry beside the base scene; \`make model-cases\`" \
-	    base=$(SENS_BASE) $(foreach d,$(MODEL_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+	$(call compare_rows,$(MODEL_OUT),The model's own cases at the paper's geometry beside the base scene; \`make model-cases\`,base=$(SENS_BASE),$(MODEL_ROWS),row of MODEL_ROWS)
 
 # `make resolution`: the discretisation study at the paper's geometry (the paper's §3.4):
 # the rock at 0.8 mm (RES_BASE: the base scene's run on the physics of dx0.7's run,
-# blast_paper_rerun) beside every other rock dx with a row, coarse to fine, each with its
-# difference from the 0.8 mm row, in docs/resolution_blast_paper.md (the same reader as
-# `make sensitivity`). The 1.2 and 1.0 mm rows predate the stable-step fallback and the
-# gas's bound (their commits are in the table): notes §37 reads them with §36.
+# blast_paper_rerun) beside every other rock dx with a row, coarse to fine, in
+# docs/resolution_blast_paper.md. The 1.2 and 1.0 mm rows predate the stable-step fallback
+# and the gas's bound (their commits are in the table): notes §37 reads them with §36.
 RES_BASE ?= docs/validation/blast_paper_rerun
 RES_ROWS ?= $(wildcard $(addprefix docs/validation/blast_paper_,dx1.2_contained dx1.0 dx0.7))
 RES_OUT ?= docs/resolution_blast_paper.md
 .PHONY: resolution
 resolution: install
-	@test -n "$(strip $(RES_ROWS))" || { echo "no other rock dx has a row in docs/validation/ to set beside the 0.8 mm row: run one and make validate with it first" >&2; exit 2; }
-	$(PY) benchmarks/multirate_compare.py --out $(RES_OUT) \
-	    --title "The rock's dx at the paper's geometry, beside the 0.8 mm scene; \`make resolution\`" \
-	    dx0.8=$(RES_BASE) $(foreach d,$(RES_ROWS),$(patsubst blast_paper_%,%,$(notdir $(d)))=$(d))
+	$(call compare_rows,$(RES_OUT),The rock's dx at the paper's geometry beside the 0.8 mm scene; \`make resolution\`,dx0.8=$(RES_BASE),$(RES_ROWS),other rock dx)
 
 # `make record`: the same record on a machine that lacks some of VALIDATE_RUNS' run files
 # (a new machine keeps none): each row from its run's report or run file when it is here,
