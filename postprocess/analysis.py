@@ -212,6 +212,8 @@ def target_values(m: dict) -> dict:
         "peak_sigma_rr_A": _point(m["radial_stress"], "A", "peak_MPa"),
         "peak_sigma_rr_G": _point(m["radial_stress"], "G", "peak_MPa"),
         "attenuation_n": _get(m["radial_stress"], "fit", "n"),
+        "peak_sigma_rr_A_first_pulse": _point(m["radial_stress"], "A", "first_pulse_peak_MPa"),
+        "attenuation_n_first_pulse": _get(m["radial_stress"], "first_pulse_fit", "n"),
         **{f"crack_density_zone{k + 1}": (dens[k] if dens else fr) for k in range(3)},
         "major_radial_cracks": _get(fr, "major_radial_cracks"),
         "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
@@ -235,6 +237,9 @@ def _bases(m: dict) -> dict:
               else ""),
            "attenuation_n": (f"{rs['fit']['n_points']} probes"
                              if "fit" in rs and "n_points" in rs["fit"] else ""),
+           "attenuation_n_first_pulse": (f"{rs['first_pulse_fit']['n_points']} probes"
+                                         if "n_points" in rs.get("first_pulse_fit", {})
+                                         else ""),
            "major_radial_cracks": f"median of {ns} sections",
            "crushed_zone": f"mean of {ns} sections",
            "ring_arc_length": f"mean of {ns} sections",

@@ -77,9 +77,11 @@ def first_arrival(t, y, fraction: float = FRACTION, t_failed: float | None = Non
                 "failed_in_first_pulse": True}
     y0, y1 = y[k - 1], y[k]
     ta = float(t[k - 1] + (thr - y0) / (y1 - y0) * (t[k] - t[k - 1]))
+    kf = k + int(np.nanargmax(y[k:end + 1]))
     return {"t_s": ta, "threshold_Pa": thr, "peak_Pa": peak, "t_peak_s": float(t[kp]),
             "first_pulse_end_s": float(t[end]), "first_pulse_peak_Pa": first_peak,
-            "peak_in_first_pulse": kp <= end}
+            "t_first_pulse_peak_s": float(t[kf]),
+            "first_pulse_complete": end < len(y) - 1, "peak_in_first_pulse": kp <= end}
 
 
 def _pulse_end(y, k: int) -> int:

@@ -16,6 +16,15 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
   (d in mm, p in MPa; paper: ~130 MPa at A, < 20 MPa at G, n = 0.798).  A probe
   whose peak is the last recorded step (the wave has not passed it yet) is shown
   but left out of the fits and of the wave speed.
+* The direct wave's peak (information): the peak of each probe's **first pulse**
+  (:mod:`postprocess.arrivals`: from the first arrival until -sigma_rr falls below half
+  its running maximum), and p = C d^-n fitted over those.  The whole-run peak above is
+  the largest compression at the point over every step; where a later event (the
+  crushed zone's compression, a reflection, a crack reaching the point) exceeds the
+  direct wave, the two differ.  The paper's Fig. 16a records show a series of waves
+  of reducing magnitude, whose first is the direct wave.  A probe whose point fails
+  during its first pulse, or whose first pulse has not ended by the end of the
+  record, has no first-pulse peak (the reason is given).
 * Wave speed (Fig. 16b): from the first arrivals at A–G (:mod:`postprocess.arrivals`:
   10 % of the peak of each probe's first pulse, arrival times increasing with d, least-squares slope
   of d against t; Table 1's c_P = sqrt((K + 4G/3)/rho) = 4595 m/s), and beside it the
@@ -130,16 +139,38 @@ def radial_stress(probes) -> dict:
         q = probes[n]
         t, pk, interior = fits.peak_time(*arrivals.state_samples(q, -q["sigma_rr"]))
         pts.append({"name": n, "d_mm": q["d"] * 1e3, "paper_d_mm": SERIES[n],
-                    "peak_MPa": pk / 1e6, "t_peak_us": t * 1e6, "peak_inside_record": interior})
+                    "peak_MPa": pk / 1e6, "t_peak_us": t * 1e6, "peak_inside_record": interior,
+                    **_first_pulse_peak(q)})
     out = {"points": pts, "missing": missing, "errors": bad}
     out["fit"] = _fit([p for p in pts if p["peak_inside_record"]], "peak_MPa")
     out["excluded_from_fit"] = [p["name"] for p in pts if not p["peak_inside_record"]]
+    direct = [p for p in pts if not isinstance(p["first_pulse_peak_MPa"], dict)]
+    out["first_pulse_fit"] = _fit(direct, "first_pulse_peak_MPa")
+    out["excluded_from_first_pulse_fit"] = {p["name"]: p["first_pulse_peak_MPa"]["not_available"]
+                                            for p in pts if p not in direct}
     return out
 
 
+def _first_pulse_peak(q) -> dict:
+    """{first_pulse_peak_MPa, t_first_pulse_peak_us} of a probe: the peak of the direct
+    wave (its first pulse), or first_pulse_peak_MPa = {"not_available": why}."""
+    a = arrivals.first_arrival(*arrivals.state_samples(q, -q["sigma_rr"]),
+                               t_failed=failure_time(q))
+    if "not_available" in a:
+        return {"first_pulse_peak_MPa": {"not_available": a["not_available"]},
+                "t_first_pulse_peak_us": None}
+    if not a["first_pulse_complete"]:
+        return {"first_pulse_peak_MPa": {"not_available": "the first pulse has not ended by "
+                                         "the end of the record"},
+                "t_first_pulse_peak_us": None}
+    return {"first_pulse_peak_MPa": a["first_pulse_peak_Pa"] / 1e6,
+            "t_first_pulse_peak_us": a["t_first_pulse_peak_s"] * 1e6}
+
+
 def _fit(pts, key) -> dict:
-    """Power law over the probes whose peak lies inside the record (a peak at the last
-    step means the wave has not yet passed: that probe's peak is not known)."""
+    """Power law over the probes given: those whose peak lies inside the record (a peak
+    at the last step means the wave has not yet passed: that probe's peak is not known),
+    or whose first pulse has a peak."""
     try:
         return fits.power_law([p["d_mm"] for p in pts], [p[key] for p in pts])
     except fits.FitError as e:

@@ -213,14 +213,18 @@ def _radial(doc) -> list[str]:
         return L + [f"Not available: {r['not_available']}.", ""]
     first = {a["name"]: a for a in w.get("arrivals", [])}
     L += ["| probe | d (mm) | paper d (mm) | peak −σ_rr (MPa) | peak time (µs) | "
-          "first arrival (µs) | peak in first pulse |", "|---|---|---|---|---|---|---|"]
+          "first arrival (µs) | peak in first pulse | first pulse's peak (MPa) at (µs) |",
+          "|---|---|---|---|---|---|---|---|"]
     for p in r["points"]:
         a = first.get(p["name"])
+        fp = p.get("first_pulse_peak_MPa")
+        fp = ("not in this report" if fp is None else "—" if isinstance(fp, dict)
+              else f"{fp:.4g} at {p['t_first_pulse_peak_us']:.4g}")
         L.append(f"| {p['name']} | {p['d_mm']:.3g} | {p['paper_d_mm']} | {p['peak_MPa']:.4g} | "
                  f"{p['t_peak_us']:.4g}{'' if p['peak_inside_record'] else ' (end of record)'} | "
                  f"{'—' if a is None else format(a['t_us'], '.4g')} | "
-                 f"{'—' if a is None else _f(a['peak_in_first_pulse'])} |")
-    L += [f"| {e['name']} | **error** | | **error** | | | |" for e in r.get("errors", [])]
+                 f"{'—' if a is None else _f(a['peak_in_first_pulse'])} | {fp} |")
+    L += [f"| {e['name']} | **error** | | **error** | | | | |" for e in r.get("errors", [])]
     if r["missing"]:
         L += ["", f"Probes not in the run: {', '.join(r['missing'])}."]
     if r.get("excluded_from_fit"):
@@ -230,6 +234,14 @@ def _radial(doc) -> list[str]:
     L += ["", "Power law p = C d^-n: " + (f"not available: {f['not_available']}" if _na(f) else
           f"C = {f['C']:.4g} MPa·mm^n, n = {f['n']:.3f}, R² = {f['r2']:.3f} over "
           f"{f['n_points']} probes") + " (paper: n = 0.798).", ""]
+    if "first_pulse_fit" in r:
+        g, gone = r["first_pulse_fit"], r.get("excluded_from_first_pulse_fit", {})
+        L += ["Over the first pulses' peaks (the direct wave; information): " + (
+            f"not available: {g['not_available']}" if _na(g) else
+            f"C = {g['C']:.4g} MPa·mm^n, n = {g['n']:.3f}, R² = {g['r2']:.3f} over "
+            f"{g['n_points']} probes") + (
+            "; without " + "; ".join(f"{k} ({v})" for k, v in gone.items()) if gone else "")
+            + ".", ""]
     L += _speeds(w)
     return L + _fig(doc, "fig16a_radial_stress") + _fig(doc, "fig16b_wave_speed") \
         + _fig(doc, "fig17_peak_radial_stress")

@@ -12,7 +12,8 @@ physical consistency check (``kind = "consistency"``): it must lie between the
 constant-volume explosion pressure p(1, e0) and the Chapman–Jouguet pressure, both
 computed from the run's own JWL constants (:mod:`postprocess.explosive`): the
 paper's "up to 1800 MPa" contradicts its Table 2 (p_CJ = 15.5 GPa), so it is shown
-but not judged.  The wall pressure and the peak-arrival wave speed are
+but not judged.  The wall pressure, the peak-arrival wave speed and the direct
+wave's peaks (the first pulse's, beside the judged whole-run peaks) are
 information only (``kind = "information"``, verdict "information").
 
 A value is a number, ``{"not_available": reason}`` or ``{"error": message}`` (an
@@ -51,6 +52,12 @@ TARGETS = (
            "< 20", "—", 0.0, 20.0, "below 20"),
     Target("attenuation_n", "attenuation exponent n of p = C d^-n (Fig. 17)", "—",
            "0.798", "agrees (Fig. 17)", 0.698, 0.898, "0.798 ± 0.1"),
+    Target("peak_sigma_rr_A_first_pulse", "peak radial stress at A in its first pulse "
+           "(the direct wave)", "MPa", "≈130", "—", None, None,
+           "information only: the whole-run peak is judged", "information"),
+    Target("attenuation_n_first_pulse", "attenuation exponent n over the first pulses' "
+           "peaks A–G (the direct wave)", "—", "0.798", "agrees (Fig. 17)", None, None,
+           "information only: the whole-run peaks' n is judged", "information"),
     Target("crack_density_zone1", "crack density, zone 1 (Fig. 12)", "mm/mm²",
            "slightly below experiment", "0.30–0.46", 0.30, 0.46, "experiment's range"),
     Target("crack_density_zone2", "crack density, zone 2 (Fig. 12)", "mm/mm²",

@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 from conftest import ROOT, child_env, run_cli
 
+from postprocess.targets import TARGETS
+
 DX, R_WALL, R_OUT, NZ = 1e-3, 3e-3, 30e-3, 4
 C_WAVE, N_ATT, C_ATT = 4000.0, 0.8, 300e6          # synthetic wave: speed, attenuation
 DT = 1e-8
@@ -668,6 +670,23 @@ def test_first_arrival_gives_the_p_wave_speed(tmp_path):
     assert row["wave_speed"]["verdict"] == "within"
     assert row["wave_speed"]["value"] == pytest.approx(ws["speed_m_s"])
     assert m["errors"] == []
+    # the direct wave's peaks are the first pulses' amplitudes, 300 (d/mm)^-0.8 MPa at
+    # t0 + d/c_P + T/2 (to a sample: DT = 0.01 µs on a 2 µs half-sine), so their power
+    # law has n = 0.8, while the reflections carry the whole-run peaks at B, D and F
+    rs = m["radial_stress"]
+    for p in rs["points"]:
+        dm = d[p["name"]] * 1e3
+        assert p["first_pulse_peak_MPa"] == pytest.approx(300 * dm ** -0.8, rel=2e-4)
+        assert p["t_first_pulse_peak_us"] == pytest.approx(
+            (t0 + d[p["name"]] / C_P + T / 2) * 1e6, abs=0.006)
+        assert (p["peak_MPa"] > 1.4 * p["first_pulse_peak_MPa"]) == (p["name"] in reflected)
+    assert rs["first_pulse_fit"]["n"] == pytest.approx(0.8, abs=2e-4)
+    assert rs["excluded_from_first_pulse_fit"] == {}
+    assert abs(rs["fit"]["n"] - 0.8) > 0.01 and rs["fit"]["r2"] < 0.9 < rs["first_pulse_fit"]["r2"]
+    assert row["attenuation_n_first_pulse"]["verdict"] == "information"
+    assert row["attenuation_n_first_pulse"]["value"] == pytest.approx(0.8, abs=2e-4)
+    assert row["peak_sigma_rr_A_first_pulse"]["value"] == pytest.approx(
+        300 * (d["A"] * 1e3) ** -0.8, rel=2e-4)
 
 
 def test_first_arrival_threshold_is_the_first_pulses():
@@ -719,6 +738,13 @@ def test_a_probe_that_fails_in_its_first_pulse_has_no_arrival(tmp_path):
     assert len(ws["threshold_study"][0]["t_us"]) == 6
     row = {r["key"]: r for r in m["targets"]}
     assert row["wave_speed"]["verdict"] == "within" and m["errors"] == []
+    # A's first-pulse peak would be its failure stress: none, with the reason; B-G are
+    # the half-sines' amplitudes, 50 / (d/mm) MPa: n = 1 over them
+    rs = m["radial_stress"]
+    assert "during its first pulse" in rs["excluded_from_first_pulse_fit"]["A"]
+    assert rs["first_pulse_fit"]["n"] == pytest.approx(1.0, abs=2e-4)
+    assert rs["first_pulse_fit"]["n_points"] == 6
+    assert row["peak_sigma_rr_A_first_pulse"]["verdict"].startswith("not available")
     # without the failure the ramp's arrival stands: 10 % of 200 MPa at t0 + 0.25 µs
     t = np.arange(1501) * DT
     ramp = 200e6 * np.clip((t - t0) / 2.5e-6, 0.0, 1.0) * (t < 6e-6)
@@ -983,7 +1009,7 @@ def test_report_on_blast_demo_under_mpirun(demo_run, tmp_path):
     md = (tmp_path / "rep2" / "report.md").read_text()
     # 17 rows: the peak-arrival wave speed is shown beside the judged first-arrival one,
     # and the ring arcs' length is information
-    assert "| quantity | this run |" in md and len(doc["targets"]) == 17
+    assert "| quantity | this run |" in md and len(doc["targets"]) == len(TARGETS)
     # the crack orientation on each crack section, its classes adding up to the failed
     for s in doc["fracture"]["sections"].values():
         for z, zo in zip(s["zones"], s["orientation"]["zones"]):
