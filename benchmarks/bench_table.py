@@ -65,6 +65,14 @@ def table(runs: dict, peer: dict) -> list[str]:
         out.append(f"| `blast_paper_slice`: wall s per simulated µs | 1 / 2 | single-rate {s}, "
                    f"ratio {pair[0]['max_ratio']} {m} | speed-up {x} (bond work: "
                    f"{float(pair[0]['projected_speedup']):.2f}×) | |")
+    rs = [runs.get(("restart", n)) for n in (1, 2)]
+    if all(rs):
+        out.append("| restore of the `jh2` block's checkpoint, "
+                   f"{100 * int(rs[0]['broken_pairs']) / int(rs[0]['bonds']):.0f} % of the bonds "
+                   "broken (benchmarks/restart_bench.py) | 1 / 2 | — | restore "
+                   + " / ".join(f"{float(kv['restore_s']):.2f}" for kv in rs) + " s | "
+                   + " / ".join(f"{kv['restore_extra_mib']}" for kv in rs)
+                   + " MiB per rank above the built model |")
     if peer:
         rates = " / ".join(f"{float(peer[n]['bond_updates_per_s_per_core']) / 1e6:.1f}"
                            for n in sorted(peer))

@@ -1,4 +1,5 @@
-"""`make bench`: every benchmark case on 1 and 2 ranks, then the LAMMPS peer if installed.
+"""`make bench`: every benchmark case on 1 and 2 ranks, the restore's memory and time
+(benchmarks/restart_bench.py), then the LAMMPS peer if installed.
 
 Usage: python benchmarks/run.py [--size N] [--steps S] [--ranks 1,2] [--no-peer]
 """
@@ -35,6 +36,19 @@ def main():
             if res.returncode:
                 sys.stderr.write(res.stderr)
                 status = 1
+    for n in map(int, args.ranks.split(",")):     # the restore's memory and time
+        where = HERE.parent / "runs" / "restart_bench" / f"ranks{n}"
+        base = ["mpirun", "--oversubscribe", "-n", str(n), sys.executable,
+                str(HERE / "restart_bench.py")]
+        for phase in ("write", "restore"):
+            res = subprocess.run(base + [phase, "--size", str(args.size), "--dir", str(where)],
+                                 env=env, capture_output=True, text=True)
+            sys.stdout.write(res.stdout)
+            if res.returncode:
+                sys.stderr.write(res.stderr)
+                status = 1
+                break
+        shutil.rmtree(where, ignore_errors=True)
     if args.no_peer:
         return status
     if shutil.which("lmp") and PEER.exists():

@@ -20,6 +20,10 @@ LOG = "\n".join([
     "max_ratio=4 projected_speedup=3.0",
     "peer lammps peri/lps: ranks=1, particles=8, bond_updates_per_s_per_core=2.5e+07",
     "peer lammps peri/lps: ranks=2, particles=8, bond_updates_per_s_per_core=2.0e+07",
+    "bench restart ranks=1 points=8 bonds=80 broken_pairs=24 build_peak_mib=100 "
+    "rss_built_mib=90 restore_peak_mib=120 restore_extra_mib=30 restore_s=0.50",
+    "bench restart ranks=2 points=8 bonds=80 broken_pairs=24 build_peak_mib=60 "
+    "rss_built_mib=55 restore_peak_mib=70 restore_extra_mib=15 restore_s=0.25",
     "unrelated line",
 ])
 
@@ -35,7 +39,10 @@ def test_the_table_carries_each_run_of_the_log():
     assert "single-rate 12.00 / 7.00, ratio 4 6.00 / 2.00" in slice_row
     assert "2.00× / 3.50×" in slice_row and "3.00×" in slice_row
     assert "| 25.0 / 20.0 |" in next(ln for ln in lines if "LAMMPS" in ln)
-    assert not any("jh2" in ln for ln in lines)                      # not in the log
+    assert not any(ln.startswith("| `jh2") for ln in lines)          # not in the log
+    restore = next(ln for ln in lines if "restore of" in ln)
+    assert "30 % of the bonds" in restore and "restore 0.50 / 0.25 s" in restore   # 24 / 80
+    assert "30 / 15 MiB per rank" in restore
 
 
 def test_the_change_between_two_logs():
