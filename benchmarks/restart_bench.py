@@ -30,6 +30,7 @@ from case import jh2_block  # noqa: E402
 
 from mpipd.input.scene import Scene  # noqa: E402
 from mpipd.input.schema import build  # noqa: E402
+from mpipd.kernels.hashrng import uniform  # noqa: E402
 from mpipd.output import checkpoint  # noqa: E402
 from mpipd.parallel.team import Team  # noqa: E402
 from mpipd.solver import Simulation  # noqa: E402
@@ -49,13 +50,13 @@ def reset_peak():
 
 
 def break_bonds(sim, fraction: float):
-    """Break the bonds whose gid pair hashes below ``fraction`` (both directed copies)."""
+    """Break the bonds whose gid pair draws below ``fraction`` (both directed copies:
+    mpipd.kernels.hashrng keyed by lo * N + hi, the same on every rank count)."""
     fam, gid = sim.families, sim.points.gid
     rows = np.repeat(np.arange(len(fam.offsets) - 1), np.diff(fam.offsets))
     a, b = gid[rows], gid[fam.nbr]
-    lo, hi = np.minimum(a, b).astype(np.uint64), np.maximum(a, b).astype(np.uint64)
-    h = (lo * np.uint64(0x9E3779B97F4A7C15) ^ hi * np.uint64(0xC2B2AE3D27D4EB4F)) >> np.uint64(40)
-    fam.broken[:] = (h.astype(np.float64) / float(1 << 24) < fraction).astype(np.uint8)
+    keys = np.minimum(a, b).astype(np.int64) * sim.n_global + np.maximum(a, b)
+    fam.broken[:] = (uniform(0, 0, keys) < fraction).astype(np.uint8)
 
 
 def main():
