@@ -42,8 +42,8 @@ from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
 #: allocates (``tests/test_memory.py`` checks it against a walk of every array)
-BYTES_PER_LOCAL_POINT = 212     # x, gid, part, material, volume, horizon, dx, influence, u, v,
-#                                 fd, cbb, mode, step class and base class
+BYTES_PER_LOCAL_POINT = 284     # x, gid, part, material, volume, horizon, dx, influence, u, v,
+#                                 fd, spring reference map, cbb, mode, step class and base class
 BYTES_PER_OWNED_POINT = 683     # a, f, rho, fixed, offsets, K^-1, tr K, gamma, spring, F,
 #                                 F_old, Fdot, R, V, sigma, d, J, W, hourglass modulus, group
 #                                 index, volume factor, fallback toggles, ledger row index,

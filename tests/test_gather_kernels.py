@@ -40,8 +40,10 @@ def lattice(seed, n=5, dx=1.0e-3, m=3.0):
     fd[:, :9] = rng.normal(0.0, 1.0e9, (N, 9)) / delta ** 5
     fd[:, FD_H] = rng.uniform(0.5, 1.5, N) * 1.0e9 / delta ** 5
     cbb = np.full(N, 18 * 50e9 / (np.pi * delta ** 4))
+    # spring reference maps (rest length |G xi|; read only where an end is on the springs)
+    G = np.eye(3) + rng.normal(0.0, 0.1, (N, 3, 3))
     return dict(x=x, u=u, v=v, vol=vol, horizon=horizon, wi=wi, wj=wj, rinv=rinv, offsets=offsets,
-                nbr=nbr, fd=fd, cbb=cbb, rng=rng)
+                nbr=nbr, fd=fd, G=G, cbb=cbb, rng=rng)
 
 
 def gather(L, klass, level, broken=None, contact=False, fd=None):
@@ -52,7 +54,7 @@ def gather(L, klass, level, broken=None, contact=False, fd=None):
     f = np.empty((N, 3))
     fv = np.empty((N, 3) if fd.shape[1] > 11 else (0, 3))
     nosb.gather_forces(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
-                       L["offsets"], L["nbr"], broken, fd, L["cbb"], contact, f, fv,
+                       L["offsets"], L["nbr"], broken, fd, L["G"], L["cbb"], contact, f, fv,
                        klass, kmin, level)
     return f, fv
 
@@ -82,6 +84,41 @@ def test_gather_is_eq1_with_the_multirate_weights(level):
     scale = np.abs(want).max()
     assert scale > 0.0
     assert np.abs(f - want).max() <= 1e-12 * scale
+
+
+def test_springs_stretch_from_their_reference_maps():
+    """Every point on the bond springs (B = h = 0): Eq. 1 is the sum of the two
+    half-springs, (c_p / 2) s_p Y/|Y| with s_p = (|Y| - |G_p xi|) / |xi| for each end p
+    whose horizon holds the bond, written out here in numpy; and a point whose G is
+    its affine F feels no spring force in that affine field."""
+    L = lattice(5)
+    N = len(L["x"])
+    fd = np.zeros((N, 11))
+    fd[:, FD_SPRING] = 1.0
+    level = 2
+    klass = L["rng"].integers(0, 3, N).astype(np.uint8)
+    f, _ = gather(L, klass, level, fd=fd)
+    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
+    j = L["nbr"]
+    xi = L["x"][j] - L["x"][i]
+    Y = xi + L["u"][j] - L["u"][i]
+    r, ly = np.linalg.norm(xi, axis=1), np.linalg.norm(Y, axis=1)
+    wt = 2.0 ** klass.astype(float)
+
+    def half(p, w):
+        s = (ly - np.linalg.norm(np.einsum("bij,bj->bi", L["G"][p], xi), axis=1)) / r
+        return np.where(w > 0, 0.5 * L["cbb"][p] * s * wt[p], 0.0)
+
+    fb = (L["vol"][j] * (half(i, L["wi"]) + half(j, L["wj"])) / ly)[:, None] * Y
+    want = np.zeros((N, 3))
+    np.add.at(want, i, fb)
+    assert np.abs(f - want).max() <= 1e-12 * np.abs(want).max()
+    # an affine field Y = A xi with every G = A: the springs are at rest
+    A = np.array([[2.3, 0.1, 0.0], [-0.2, 1.9, 0.05], [0.0, 0.1, 0.6]])
+    L["u"] = L["x"] @ (A - np.eye(3)).T
+    L["G"] = np.broadcast_to(A, (N, 3, 3)).copy()
+    f, _ = gather(L, klass, level, fd=fd)
+    assert np.abs(f).max() <= 1e-9 * np.abs(want).max()
 
 
 def full_setup(seed):
@@ -123,7 +160,7 @@ def test_reweight_is_the_difference_of_two_gathers(seed):
         g = np.empty((len(rows), 3))
         gv = np.empty((len(rows), 3))
         nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
-                             L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, rows,
+                             L["offsets"], L["nbr"], broken, L["fd"], L["G"], L["cbb"], True, rows,
                              old, new, top, g, gv)
         want = (f_new - f_old)[rows]
         scale = np.abs(f_new).max()
@@ -134,7 +171,7 @@ def test_reweight_is_the_difference_of_two_gathers(seed):
     g = np.empty((N, 3))
     gv = np.empty((N, 3))
     nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
-                         L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
+                         L["offsets"], L["nbr"], broken, L["fd"], L["G"], L["cbb"], True, np.arange(N),
                          old, new, top, g, gv)
     net = (L["vol"][:, None] * g).sum(axis=0)
     assert np.abs(net).max() <= 1e-12 * (L["vol"][:, None] * np.abs(g)).sum()
@@ -147,6 +184,6 @@ def test_unchanged_classes_change_nothing():
     g = np.full((N, 3), np.nan)
     gv = np.full((N, 3), np.nan)
     nosb.gather_reweight(L["x"], L["u"], L["v"], L["vol"], L["horizon"], L["wi"], L["wj"], L["rinv"],
-                         L["offsets"], L["nbr"], broken, L["fd"], L["cbb"], True, np.arange(N),
+                         L["offsets"], L["nbr"], broken, L["fd"], L["G"], L["cbb"], True, np.arange(N),
                          k, k.copy(), 2, g, gv)
     assert (g == 0.0).all() and (gv == 0.0).all()

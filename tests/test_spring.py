@@ -152,3 +152,74 @@ def test_a_face_cut_by_a_joint_is_stable_beyond_the_critical_step(team):
         worst = max(worst, abs(sim.energies().total / e0 - 1.0))
     assert worst < 0.01, worst
     assert sim.corr.n_spring == 0
+
+
+# -------------------------------------------------- the springs' reference map
+def _stretched_block(team):
+    """A 7^3 granite block (dx 1 mm) in the affine field u = (A - I) x of a large,
+    mostly plastic-sized deformation A (the copper tube of docs/validation_notes.md §40
+    is blown out to 2.3-2.5 times its radius), F computed (initialize); its centre."""
+    dx = 1e-3
+    sim = Simulation(make_scene(scene_dict({"kind": "box", "lo": [0, 0, 0],
+                                            "hi": [7 * dx] * 3}, dx=dx)), team)
+    A = np.array([[2.3, 0.2, 0.0], [-0.1, 2.4, 0.1], [0.0, 0.05, 0.45]])
+    sim.u[:] = sim.points.x @ (A - np.eye(3)).T
+    sim.initialize()
+    n = sim.points.n_owned
+    c = int(np.argmin(np.linalg.norm(sim.points.x[:n] - 3.5 * dx, axis=1)))
+    np.testing.assert_allclose(sim.corr.F[c], A, rtol=0, atol=1e-12)
+    return sim, A, c
+
+
+def _reference_spring_energy(sim, c, A, keep=None):
+    """Point c's spring energy if its springs measured stretch from the reference
+    (s = |A xi|/|xi| - 1, the paper's G = I): V_c sum_j (c_bb / 4) s^2 |xi| V_j."""
+    p, fam = sim.points, sim.families
+    b0, b1 = fam.offsets[c], fam.offsets[c + 1]
+    xi = p.x[fam.nbr[b0:b1]] - p.x[c]
+    r = np.linalg.norm(xi, axis=1)
+    ok = (r < p.horizon[c]) & (np.ones(len(r), bool) if keep is None else keep)
+    s = np.linalg.norm(xi @ A.T, axis=1) / r - 1.0
+    return p.volume[c] * np.sum((sim.corr.cbb[c] / 4) * s[ok] ** 2 * r[ok]
+                                * p.volume[fam.nbr[b0:b1]][ok])
+
+
+def test_a_point_whose_shape_tensor_goes_singular_keeps_its_configuration_unloaded(team):
+    """Bonds break until K is singular (two opposite bonds left): the point takes the
+    springs with its F of before as reference map G, so in its affine field they hold
+    nothing; measured from the reference they would hold E0 (computed here)."""
+    from mpipd.kernels.layout import SPRING_K
+    sim, A, c = _stretched_block(team)
+    fam, x = sim.families, sim.points.x
+    b0, b1 = fam.offsets[c], fam.offsets[c + 1]
+    xi = x[fam.nbr[b0:b1]] - x[c]
+    keep = (np.abs(np.abs(xi[:, 0]) - 1e-3) < 1e-9) & (np.abs(xi[:, 1:]).sum(axis=1) < 1e-9)
+    assert keep.sum() == 2
+    fam.broken[b0:b1] = ~keep
+    sim.corr.rebuild_shape(np.array([c]), sim.u)
+    assert sim.corr.spring[c] == SPRING_K
+    np.testing.assert_allclose(sim.corr.G[c], A, rtol=0, atol=1e-12)
+    E0 = _reference_spring_energy(sim, c, A, keep)
+    E = sim.corr.potentials(np.array([c]), sim.u)[0, 1]
+    assert E0 > 1.0e-3 and abs(E) <= 1e-12 * E0
+
+
+def test_a_point_whose_F_turns_singular_takes_its_last_F_as_spring_reference(team):
+    """F of the centre point turned singular (det F < 0) while F_old is the affine A:
+    force_data switches it to the springs (SPRING_F) with G = A, their energy in the
+    affine field is 0, and the ledger books the jump as energy removed (the hourglass
+    energy of the singular F), not created; from the reference the springs would
+    have held E0 > 10 times that hourglass energy."""
+    from mpipd.kernels.layout import SPRING_F
+    sim, A, c = _stretched_block(team)
+    np.testing.assert_allclose(sim.corr.F_old[c], A, rtol=0, atol=1e-12)
+    sim.corr.F[c] = np.diag([-1.0, 1.0, 1.0]) @ A
+    hg = sim.corr.potentials(np.array([c]), sim.u)[0, 0]
+    j0 = sim.ledger.jumps
+    sim.corr.force_data(sim.u, sim.ledger)
+    assert sim.corr.spring[c] == SPRING_F
+    np.testing.assert_allclose(sim.corr.G[c], A, rtol=0, atol=1e-12)
+    E0 = _reference_spring_energy(sim, c, A)
+    assert E0 > 10 * hg > 0
+    assert abs(sim.corr.potentials(np.array([c]), sim.u)[0, 1]) <= 1e-12 * E0
+    assert sim.ledger.jumps - j0 == pytest.approx(hg, rel=1e-9)

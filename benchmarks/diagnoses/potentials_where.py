@@ -5,8 +5,9 @@ held when they switched in).  Builds the checkpoint's scene, restores the
 checkpoint (mpipd.output.checkpoint.restore), and sums the ledger's own per-point
 potentials (mpipd.model.correspondence.Correspondence.potentials: hourglass and
 spring energy owned by each point, kernels.energy) by material and by fallback code
-(mpipd.kernels.layout: 0 correspondence, 1 springs as K is singular, 2 springs as
-too soft for dt), then lists the largest spring-energy holders:
+(mpipd.kernels.layout: 0 correspondence, 1 springs as K is singular or too soft for
+dt, 2 springs as F is singular this step), then lists the largest spring-energy
+holders:
 
     mpirun -n 2 python benchmarks/diagnoses/potentials_where.py CHECKPOINT [--top 10]
 

@@ -8,8 +8,9 @@ the bond-spring fallback):
 * hourglass (Eq. 15, kernels.nosb):  E_i = V_i (h_i / 2) sum_j omega_i |Y - F_i xi|^2 V_j,
   h_i = 2 c M / tr K_i, for points on the correspondence model (spring[i] = CORRESPONDENCE);
 * bond-spring fallback (paper §2.1): point i's half of each intact bond inside its
-  horizon, E_i = V_i sum_j (c_bb,i / 4) s^2 |xi| V_j, s = |Y|/|xi| - 1 — the
-  potential of the half-spring force (c_bb,i / 2) s Y/|Y| (spring[i] = SPRING_K or SPRING_F);
+  horizon, E_i = V_i sum_j (c_bb,i / 4) s^2 |xi| V_j, s = (|Y| - |G_i xi|)/|xi| — the
+  potential of the half-spring force (c_bb,i / 2) s Y/|Y| (spring[i] = SPRING_K or
+  SPRING_F; G_i the point's spring reference map, kernels.nosb);
 * contact (Eq. 40, kernels.contact): half of each broken pair's penalty potential,
   E_i = (V_i / 2) sum_j c_s omegahat (|Y| - |xi|)^2 / (2 delta) V_j for |Y| < |xi|,
   whose gradient is the contact force.
@@ -27,10 +28,11 @@ import numba
 from .index import family, neighbour
 from .influence import influence
 from .layout import CORRESPONDENCE, NOT_TL
+from .nosb import rest_length
 
 
 @numba.njit(cache=True)
-def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg_modulus,
+def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, G, hg_modulus,
                      trK, spring, cbb, contact, out):
     """out[p] = (hourglass, spring, contact) energy (J) owned by point rows[p]."""
     for p in range(rows.shape[0]):
@@ -70,7 +72,7 @@ def point_potentials(rows, x, u, vol, horizon, infl, offsets, nbr, broken, F, hg
                 ehg += wi * (z0 * z0 + z1 * z1 + z2 * z2) * vol[j]
             elif code != NOT_TL:
                 ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-                s = ly / r - 1.0
+                s = (ly - rest_length(G, i, e0, e1, e2)) / r
                 esp += 0.25 * cbb[i] * s * s * r * vol[j]
         out[p, 0] = vol[i] * 0.5 * h * ehg
         out[p, 1] = vol[i] * esp

@@ -33,8 +33,15 @@ omega_j of the same bond always uses point j's function and horizon.
   (J <= 0) cannot be inverted, or where K has lost so much of its smallest
   eigenvalue that the point's force is stiffer than the step can integrate
   (mpipd.model.correspondence.stable_floor): that side of the bond acts as a
-  bond-based spring, T = (c_bb / 2) s Y/|Y| with s = |Y|/|xi| - 1 and
-  c_bb = 18 k / (pi delta^4).
+  bond-based spring, T = (c_bb / 2) s Y/|Y| with c_bb = 18 k / (pi delta^4) and
+      s = (|Y| - |G_i xi|) / |xi|,
+  G_i the point's spring reference map: its last regular F when it switched to the
+  springs (I until then).  The spring holds the elastic stretch from the
+  configuration the point had reached, not its whole stretch from the reference:
+  the paper's s = |Y|/|xi| - 1 (G = I) would charge a point that flowed plastically to
+  twice its length with springs loaded to s ~ 1, energy its stress never held
+  (docs/validation_notes.md §40).  G is owned-point state, copied to the ghosts
+  with the force data.
 """
 import math
 
@@ -266,7 +273,8 @@ def gradients_of(rows, x, u, vol, horizon, infl, offsets, nbr, broken, Kinv, spr
 
 
 @numba.njit(cache=True)
-def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, klass, level):
+def force_data(F, F_old, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, G, toggled, klass,
+               level):
     """Per-point force data of owned points: fd[i, :9] = B = A - h F (row-major),
     fd[i, FD_H] = h, fd[i, FD_SPRING] = 1.0 for a bond-spring point, else 0.0, with
     A = c J sigma F^-T K^-1 (J = det F, c = Jfac[i] the volume factor),
@@ -277,7 +285,8 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, kl
     fallback; so, for this step only, does a point whose F is singular or not
     finite (``spring[i] = SPRING_F``, re-tested every step).  The points that switched
     between 0 and 2 in this call are written to ``toggled`` (their energy is
-    booked by the ledger).  Only points whose class acts at ``level``
+    booked by the ledger); one that switched to 2 takes F_old, its F of the last
+    step (regular), as its spring reference map G (module docstring).  Only points whose class acts at ``level``
     (kernels.classes) are evaluated; the others keep their last force data.
     Returns (points on SPRING_F, points toggled).
     """
@@ -303,6 +312,10 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, kl
             if spring[i] != was:
                 toggled[n_tog] = i
                 n_tog += 1
+                if spring[i] == SPRING_F:
+                    for r in range(3):
+                        for c in range(3):
+                            G[i, r, c] = F_old[i, r, c]
         if spring[i] != CORRESPONDENCE:
             for c in range(FD_SPRING):
                 fd[i, c] = 0.0
@@ -327,10 +340,11 @@ def force_data(F, R, sigma, Kinv, trK, spring, hg_modulus, Jfac, fd, toggled, kl
 
 
 @numba.njit(**BOND_LOOP)
-def gather_forces(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f,
-                  fv, klass, kmin, level):
+def gather_forces(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, G, cbb, contact,
+                  f, fv, klass, kmin, level):
     """Internal force density f (N/m^3) of every owned point (see module docstring);
-    ``wi``, ``wj``, ``rinv``: the bonds' omega_i, omega_j and 1/|xi| (:func:`bond_influence`).
+    ``wi``, ``wj``, ``rinv``: the bonds' omega_i, omega_j and 1/|xi| (:func:`bond_influence`);
+    ``G``: every local point's spring reference map (read where an end is on the springs).
 
     ``contact``: broken bonds in compression push apart (Eq. 40, see
     kernels.contact).  If ``fd`` has 13 columns, the artificial viscosity
@@ -347,13 +361,13 @@ def gather_forces(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd,
     bond's impulses are equal and opposite.  A point whose closed family has
     no class acting (``kmin[i] > level``) gets f = 0.
     """
-    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f, fv,
+    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, G, cbb, contact, f, fv,
             klass, klass, kmin, level, kmin[:0].astype(np.int64), False)
 
 
 @numba.njit(**BOND_LOOP)
-def gather_reweight(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact,
-                    rows, old, new, top, g, gv):
+def gather_reweight(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, G, cbb,
+                    contact, rows, old, new, top, g, gv):
     """g[p] (gv[p]: its viscous share) = f_i(classes ``new``) - f_i(classes ``old``) at a
     coarse boundary (``top``: every class acts) for the owned points i = rows[p], in
     one pass over their bonds: a bond's force (:func:`gather_forces`) is linear in
@@ -361,12 +375,12 @@ def gather_reweight(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, f
     bond's force with the differences of the weights, and a bond whose two ends
     kept their classes adds exactly 0 and is passed over unread.  The same sums as
     two gathers, up to rounding."""
-    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, g, gv,
+    _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, G, cbb, contact, g, gv,
             new, old, new, top, rows, True)
 
 
 @numba.njit(**BOND_LOOP)
-def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, contact, f, fv,
+def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, G, cbb, contact, f, fv,
             klass, old, kmin, level, rows, diff):
     """Eq. 1 for owned points with the multi-rate weights: every owned point (row i of
     f) if not ``diff``; else the points rows[q] (row q of f) with the weights of
@@ -459,9 +473,9 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
                 r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
                 g = 0.0
                 if si != 0.0 and w_i != 0.0:
-                    g = _spring(cbb[i], r, y0, y1, y2) * ri
+                    g = _spring(cbb[i], r, rest_length(G, i, e0, e1, e2), y0, y1, y2) * ri
                 if sj != 0.0 and w_j != 0.0:
-                    g += _spring(cbb[j], r, y0, y1, y2) * rj
+                    g += _spring(cbb[j], r, rest_length(G, j, e0, e1, e2), y0, y1, y2) * rj
                 tx += g * y0
                 ty += g * y1
                 tz += g * y2
@@ -495,9 +509,19 @@ def _gather(x, u, v, vol, horizon, wi, wj, rinv, offsets, nbr, broken, fd, cbb, 
 
 
 @numba.njit(cache=True, inline="always")
-def _spring(c, r, y0, y1, y2):
-    """Half a bond-based spring: (c/2) (|Y|/r - 1) / |Y|, to multiply Y."""
+def _spring(c, r, rest, y0, y1, y2):
+    """Half a bond-based spring: (c/2) s / |Y|, s = (|Y| - rest) / r, to multiply Y."""
     ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
     if ly == 0.0:
         return 0.0
-    return 0.5 * c * (ly / r - 1.0) / ly
+    return 0.5 * c * ((ly - rest) / r) / ly
+
+
+@numba.njit(cache=True, inline="always")
+def rest_length(G, i, e0, e1, e2):
+    """|G_i xi|: the rest length of bond xi = (e0, e1, e2) in point i's bond springs
+    (module docstring; |-xi| gives the same for the bond's other direction)."""
+    a = G[i, 0, 0] * e0 + G[i, 0, 1] * e1 + G[i, 0, 2] * e2
+    b = G[i, 1, 0] * e0 + G[i, 1, 1] * e1 + G[i, 1, 2] * e2
+    c = G[i, 2, 0] * e0 + G[i, 2, 1] * e1 + G[i, 2, 2] * e2
+    return math.sqrt(a * a + b * b + c * c)

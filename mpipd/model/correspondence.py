@@ -2,7 +2,8 @@
 
 :class:`Correspondence` owns the per-point kinematic state of the owned points
 — K^-1, F (this and last step), Fdot, rotation R, left stretch V, unrotated
-stress, stress work, volume factor — and the per-point force data of all local points.  It
+stress, stress work, volume factor — and the per-point force data and spring reference
+maps of all local points.  It
 calls the kernels of :mod:`mpipd.kernels.nosb` and
 :mod:`mpipd.kernels.rotation`; materials only see the unrotated rate of
 deformation ``d`` and update the unrotated stress of their own points.
@@ -14,7 +15,7 @@ It is the "tl" model family (:class:`mpipd.model.base.Model`); its step
                         rotate: R, V, d, J (c det F)     Eqs. 6–14
                         update_stress: materials, work   Eq. 19 / 36
     force_data(u, ledger) B = P K^-1 - h F, h              Eqs. 2, 3, 15
-    (halo exchange of fd)
+    (halo exchange of fd and G)
     gather(u, v, f, fv) internal force density           Eq. 1
                         then the ghost-force correction  (mpipd.model.interface)
     commit()            F_old <- F
@@ -183,6 +184,10 @@ class Correspondence(Model):
         self.viscosity = viscosity
         # force data of owned + ghost points: B (9), h, fallback flag [, viscosity (2)]
         self.fd = np.zeros((nl, FD_WIDTH_VISCOUS if viscosity is not None else FD_WIDTH))
+        #: spring reference map of owned + ghost points (kernels.nosb): a point on the
+        #: bond springs measures its bonds' stretch from |G xi|; set when it switches in
+        self.G = np.zeros((nl, 3, 3))
+        self.G[:] = np.eye(3)
         self.dil = np.zeros(n if viscosity is not None else 0)
         if viscosity is not None:
             rho = np.array([m.density for m in mats])[points.material[:n]]
@@ -222,6 +227,9 @@ class Correspondence(Model):
         for name in ("d", "J_end"):
             add(name, own, getattr(self, name), checkpoint=self.classes.enabled)
         add("spring", own, self.spring, checkpoint=True, restore=REBUILT)
+        # exchanged with fd; restored after the rebuild of K, which would take F for it
+        add("spring_map", own, self.G, rows=LOCAL, exchanged=True, checkpoint=True,
+            restore=REBUILT)
         add("F", own, self.F)
         add("F_old", own, self.F_old, checkpoint=True, restore=LAST)
         for name in ("R", "V", "sigma", "Jfac"):
@@ -296,6 +304,10 @@ class Correspondence(Model):
         next update's increment is taken over one family.  Without it J = det F jumps when a family turns
         one-sided (a JH2 point went 133 MPa -> 18 GPa through K3 mu^3 with no
         work done) and the pressure then does work that nothing put in.
+
+        A point that this rebuild moves from the correspondence force to the
+        springs takes its F of before (its last regular F) as its spring reference
+        map G (kernels.nosb).
         """
         p, fam = self.points, self.families
         if which is None:
@@ -305,9 +317,10 @@ class Correspondence(Model):
                            fam.broken, self.Kinv, self.trK, self.gamma, self.lam, self.spring,
                            RCOND, self.floor, which)
         self.spring[self.not_tl] = NOT_TL
+        to_springs = before & (self.spring[which] == SPRING_K)
+        self.G[which[to_springs]] = self.F[which[to_springs]]
         # switched by the stable-step test alone (K invertible, below the floor)
-        self.floor_switches += int(np.count_nonzero(
-            before & (self.spring[which] == SPRING_K) & (self.lam[which] > 0.0)))
+        self.floor_switches += int(np.count_nonzero(to_springs & (self.lam[which] > 0.0)))
         if u is not None and len(which):
             Fn = np.empty((len(which), 3, 3))
             cl = self.classes
@@ -398,9 +411,9 @@ class Correspondence(Model):
         switched to or from the singular-F fallback (SPRING_F) in this call changes
         its held potentials discontinuously: the ledger books before - after."""
         cl = self.classes
-        n_bad, n_tog = nosb.force_data(self.F, self.R, self.sigma, self.Kinv, self.trK,
-                                       self.spring, self.hg_modulus, self.Jfac, self.fd,
-                                       self.toggled, cl.klass, cl.level)
+        n_bad, n_tog = nosb.force_data(self.F, self.F_old, self.R, self.sigma, self.Kinv,
+                                       self.trK, self.spring, self.hg_modulus, self.Jfac,
+                                       self.fd, self.G, self.toggled, cl.klass, cl.level)
         if self.viscosity is not None:
             viscosity_data(self.dil, self.gamma, self.J, self.trK, self.spring,
                            self.visc_l, self.visc_q, self.fd)
@@ -408,7 +421,7 @@ class Correspondence(Model):
             self.n_spring = self.count_spring()
         if n_tog and ledger is not None:
             self._book_toggles(self.toggled[:n_tog], u, ledger)
-        return (self.fd,)
+        return (self.fd, self.G)
 
     def _book_toggles(self, rows, u, ledger):
         """Potentials of ``rows`` under their other fallback code (before the
@@ -424,8 +437,8 @@ class Correspondence(Model):
         then the ghost-force correction f_i -= P_i g_i where there is one."""
         p, fam, cl = self.points, self.families, self.classes
         nosb.gather_forces(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j, self.rinv,
-                           fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact, f,
-                           fv, cl.klass, cl.kmin, cl.level)
+                           fam.offsets, fam.nbr, fam.broken, self.fd, self.G, self.cbb,
+                           self.contact, f, fv, cl.klass, cl.kmin, cl.level)
         if self.interface is not None:
             self.interface.apply(self.fd, self.F, f, cl.klass, cl.level)
 
@@ -440,8 +453,8 @@ class Correspondence(Model):
         g = np.empty((len(rows), 3))
         gv = np.empty((len(rows), 3) if len(fv) else (0, 3))
         nosb.gather_reweight(p.x, u, v, p.volume, p.horizon, self.omega_i, self.omega_j,
-                             self.rinv, fam.offsets, fam.nbr, fam.broken, self.fd, self.cbb, self.contact,
-                             rows, previous, cl.klass, cl.top, g, gv)
+                             self.rinv, fam.offsets, fam.nbr, fam.broken, self.fd, self.G, self.cbb,
+                             self.contact, rows, previous, cl.klass, cl.top, g, gv)
         f[rows] += g
         if len(fv):
             fv[rows] += gv
@@ -503,7 +516,7 @@ class Correspondence(Model):
         p, fam = self.points, self.families
         out = np.empty((len(rows), 3))
         energy.point_potentials(rows, p.x, u, p.volume, p.horizon, p.influence, fam.offsets,
-                                fam.nbr, fam.broken, self.F, self.hg_modulus, self.trK,
+                                fam.nbr, fam.broken, self.F, self.G, self.hg_modulus, self.trK,
                                 self.spring, self.cbb, self.contact, out)
         return out
 
