@@ -46,6 +46,15 @@ def lattice(seed, n=5, dx=1.0e-3, m=3.0):
                 nbr=nbr, fd=fd, G=G, cbb=cbb, rng=rng)
 
 
+def bonds(L):
+    """Every bond (i, j) of the lattice with its xi and Y, for Eq. 1 written out in numpy."""
+    N = len(L["x"])
+    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
+    j = L["nbr"]
+    xi = L["x"][j] - L["x"][i]
+    return i, j, xi, xi + L["u"][j] - L["u"][i]
+
+
 def gather(L, klass, level, broken=None, contact=False, fd=None):
     N = len(L["x"])
     fd = L["fd"] if fd is None else fd
@@ -67,10 +76,7 @@ def test_gather_is_eq1_with_the_multirate_weights(level):
     klass = L["rng"].integers(0, 3, N).astype(np.uint8)
     f, _ = gather(L, klass, level, fd=fd)
     # Eq. 1 bond by bond: V_j [r_i omega_i (B_i xi + h_i Y) + r_j omega_j (B_j xi + h_j Y)]
-    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
-    j = L["nbr"]
-    xi = L["x"][j] - L["x"][i]
-    Y = xi + L["u"][j] - L["u"][i]
+    i, j, xi, Y = bonds(L)
     r = np.where(klass <= level, 2.0 ** klass, 0.0)
     B = fd[:, :9].reshape(N, 3, 3)
     h = fd[:, FD_H]
@@ -98,10 +104,7 @@ def test_springs_stretch_from_their_reference_maps():
     level = 2
     klass = L["rng"].integers(0, 3, N).astype(np.uint8)
     f, _ = gather(L, klass, level, fd=fd)
-    i = np.repeat(np.arange(N), np.diff(L["offsets"]))
-    j = L["nbr"]
-    xi = L["x"][j] - L["x"][i]
-    Y = xi + L["u"][j] - L["u"][i]
+    i, j, xi, Y = bonds(L)
     r, ly = np.linalg.norm(xi, axis=1), np.linalg.norm(Y, axis=1)
     wt = 2.0 ** klass.astype(float)
 
