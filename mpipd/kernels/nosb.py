@@ -38,7 +38,7 @@ omega_j of the same bond always uses point j's function and horizon.
   G_i the point's spring reference map: its last regular F when it switched to the
   springs (I until then).  The spring holds the elastic stretch from the
   configuration the point had reached, not its whole stretch from the reference:
-  the paper's s = |Y|/|xi| - 1 (G = I) would charge a point that flowed plastically to
+  the standard PMB stretch s = |Y|/|xi| - 1 (G = I) would charge a point that flowed plastically to
   twice its length with springs loaded to s ~ 1, energy its stress never held
   (docs/validation_notes.md §40).  G is owned-point state, copied to the ghosts
   with the force data.
