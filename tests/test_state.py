@@ -97,6 +97,25 @@ def test_every_array_is_registered(team, name, over):
     assert sum(m["by_owner"].values()) == m["point_bytes"] + m["bond_bytes"]
 
 
+@pytest.mark.parametrize("name,over", SCENES, ids=[s[0] for s in SCENES])
+def test_every_registered_array_is_c_contiguous(team, name, over):
+    """Every registered array is, or is a column view of, a C-contiguous allocation
+    (a point's row, a tensor's 9 numbers, adjacent in memory), at the start and
+    after a few steps (arrays that are rebound): the kernels read them row by row.
+    Columns of a packed per-point table (the gas data) are views by design."""
+    def allocation(a):
+        while isinstance(a.base, np.ndarray):
+            a = a.base
+        return a
+    sim = build(name, over, team)
+    for k in range(3):
+        strided = sorted(f.name for f in sim.state.fields.values()
+                         if f.get() is not None
+                         and not allocation(f.get()).flags.c_contiguous)
+        assert not strided, f"after {k} steps, not C-contiguous: " + ", ".join(strided)
+        sim.step()
+
+
 @pytest.mark.parametrize("name,over", SCENES[1:], ids=[s[0] for s in SCENES[1:]])
 def test_every_checkpointed_field_round_trips(team, tmp_path, name, over):
     """Write a checkpoint after some steps, restore it into a new simulation of the

@@ -163,15 +163,18 @@ class Correspondence(Model):
         self.rinv = np.empty(len(families.nbr))          # 1 / |xi|
         nosb.bond_influence(points.x, points.horizon, points.influence, families.offsets,
                             families.nbr, self.omega_i, self.omega_j, self.rinv)
-        eye = np.broadcast_to(np.eye(3), (n, 3, 3))
+        # (n, 3, 3) C-contiguous: a point's tensor is 9 adjacent numbers in every kernel
+        # (np.array of a broadcast keeps the broadcast's strides, point index fastest)
+        def eye():
+            return np.tile(np.eye(3), (n, 1, 1))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
         self.spring = np.zeros(n, dtype=np.uint8)
-        self.F = np.array(eye)
-        self.F_old = np.array(eye)
+        self.F = eye()
+        self.F_old = eye()
         self.Fdot = np.zeros((n, 3, 3))
-        self.R = np.array(eye)
-        self.V = np.array(eye)
+        self.R = eye()
+        self.V = eye()
         self.sigma = np.zeros((n, 6))           # unrotated Cauchy stress, Voigt
         self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
         self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
