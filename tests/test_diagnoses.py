@@ -47,3 +47,39 @@ def test_a_slow_load_gives_the_lame_field():
         p = np.array([load.value(x) for x in t])
         k = slice(1000, 4000)
         assert y[k] == pytest.approx(p[k] * (A / r) ** 2, rel=2e-2, abs=1e-3 * p.max())
+
+
+def test_potentials_where_totals_are_the_ledgers_terms(tmp_path):
+    """benchmarks/diagnoses/potentials_where.py on a fracturing run's checkpoint, read
+    on another rank count (2 against the run's 1): its table's per-(material, code)
+    rows add up to its "all" row, count every point once, and its totals are the
+    ledger's hourglass and spring terms at the checkpoint's step as the run booked
+    them in run.h5 (a frame falls on that step)."""
+    import re
+
+    import h5py
+    from conftest import run_cli, run_mpi_script
+
+    out = tmp_path / "run"
+    res = run_cli(["run", "granite_ring", "--out", str(out), "--quiet",
+                   "--set", "parts.0.shape.z=[0.0, 0.006]", "--set", "time.t_end=1.2e-5",
+                   "--set", "output.every=40", "--stop-after", "200"], ranks=1)
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out / "run.h5", "r") as f:
+        k = int(f.attrs["frames_written"]) - 1
+        assert round(f["time"][k] / f.attrs["dt"]) == 200
+        hg, sp = f["energy/hourglass"][k], f["energy/spring"][k]
+        n_points = int(f.attrs["n_points"])
+    res = run_mpi_script(ROOT / "benchmarks" / "diagnoses" / "potentials_where.py", 2,
+                         str(out / "checkpoint.h5"))
+    assert res.returncode == 0, res.stderr
+    assert "step 200" in res.stdout
+    rows = re.findall(r"^\| (\w+) \| ?(\d*) ?\| (\d+) \| ([^|]+) \| ([^|]+) \|$", res.stdout, re.M)
+    parts = [r for r in rows if r[0] != "all"]
+    (whole,) = [r for r in rows if r[0] == "all"]
+    assert len(parts) >= 2                      # fracture put points on a fallback
+    assert sum(int(r[2]) for r in parts) == int(whole[2]) == n_points
+    for col, booked in ((3, hg), (4, sp)):
+        assert sum(float(r[col]) for r in parts) == pytest.approx(float(whole[col]), rel=1e-3)
+        assert float(whole[col]) == pytest.approx(booked, rel=1e-3, abs=1e-9)
+    assert hg > 0
