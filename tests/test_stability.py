@@ -629,7 +629,8 @@ def run_reduced(tmp_path, args):
         names = list(f["geometry/material"].attrs["names"])
         got = {"cu": f["geometry/material"][...] == names.index("copper"),
                "x": f["geometry/x"][...], "u": f["fields/u"][-1],
-               "peak": f["fields/peak_speed"][-1], "e": Energies.from_record(f["energy"])}
+               "peak": f["fields/peak_speed"][-1], "e": Energies.from_record(f["energy"]),
+               "spring": f["energy/spring"][...], "removed": f["energy/removed"][...]}
     assert not impossible(got["e"]), impossible(got["e"])
     assert np.all(np.isfinite(got["peak"]))
     return out, got
@@ -690,25 +691,27 @@ def test_paper_geometry_with_the_gas_contact_runs_past_the_thinned_tube(tmp_path
 # 0.11 of its thickness (principal stretches 0.11, 2.5, 3.6 at 20 us in both), and its
 # correspondence force went unstable (copper speeds 530 -> 8200 m/s between 25.3 and
 # 25.5 us).  The case now steps at dt = 5e-9 s with max_ratio 8.
-CONTACT_08_REDUCED = ["blast_paper:gas_contact", "--set", "parts.0.shape.z=[0.0, 0.025]",
-                      "--set", "parts.1.shape.z=[0.0, 0.025]",
-                      "--set", "parts.2.shape.z=[0.0, 0.025]",
-                      "--set", "parts.2.shape.radius=0.020", "--set", "probes=[]",
-                      "--set", "time.t_end=3.0e-5", "--set", "output.every=400",
-                      "--set", "output.checkpoint_every=6000"]
+def cut_25mm(case, rock_radius, t_end, every, checkpoint_every):
+    """The arguments of a paper case with all three parts cut to z = 0-25 mm and the
+    rock to ``rock_radius``, without probes."""
+    args = [case]
+    for k in range(3):
+        args += ["--set", f"parts.{k}.shape.z=[0.0, 0.025]"]
+    return args + ["--set", f"parts.2.shape.radius={rock_radius}", "--set", "probes=[]",
+                   "--set", f"time.t_end={t_end}", "--set", f"output.every={every}",
+                   "--set", f"output.checkpoint_every={checkpoint_every}"]
+
+
+CONTACT_08_REDUCED = cut_25mm("blast_paper:gas_contact", "0.020", "3.0e-5", 400, 6000)
 
 
 @pytest.mark.long
 def test_paper_geometry_gas_contact_at_the_papers_rock_runs_past_the_thinned_tube(tmp_path):
-    import h5py
-    out, got = run_reduced(tmp_path, CONTACT_08_REDUCED)
+    _, got = run_reduced(tmp_path, CONTACT_08_REDUCED)
     cu, x, u = got["cu"], got["x"], got["u"]
-    with h5py.File(out / "run.h5", "r") as f:
-        spring = f["energy/spring"][...]
-        removed = f["energy/removed"][...]
     assert abs(got["e"].balance) < 1e-4                # measured +4.3e-5 at 30 us
-    assert removed.min() >= 0.0
-    assert spring.max() < 0.01                          # measured 4e-6 J
+    assert got["removed"].min() >= 0.0
+    assert got["spring"].max() < 0.01                   # measured 4e-6 J
     r0 = np.hypot(x[cu, 0], x[cu, 1])
     r = np.hypot(x[cu, 0] + u[cu, 0], x[cu, 1] + u[cu, 1])
     assert (r / r0).max() > 4.0                        # past the thinning: measured 4.45
@@ -729,25 +732,15 @@ def test_paper_geometry_gas_contact_at_the_papers_rock_runs_past_the_thinned_tub
 # before any point took the springs.  The band's rock gives way, and the tube, blown
 # out to 2.1-2.7 x its radius, thins beyond the paper's dt; the case now halves dt at
 # max_ratio 8 (docs/validation_notes.md §40).
-SEAMLESS_REDUCED = ["blast_paper:seamless", "--set", "parts.0.shape.z=[0.0, 0.025]",
-                    "--set", "parts.1.shape.z=[0.0, 0.025]",
-                    "--set", "parts.2.shape.z=[0.0, 0.025]",
-                    "--set", "parts.2.shape.radius=0.015", "--set", "probes=[]",
-                    "--set", "time.t_end=2.0e-5", "--set", "output.every=200",
-                    "--set", "output.checkpoint_every=2000"]
+SEAMLESS_REDUCED = cut_25mm("blast_paper:seamless", "0.015", "2.0e-5", 200, 2000)
 
 
 @pytest.mark.long
 def test_paper_geometry_seamless_tube_on_the_springs_stays_booked(tmp_path):
-    import h5py
-    out, got = run_reduced(tmp_path, SEAMLESS_REDUCED)
-    e = got["e"]
-    with h5py.File(out / "run.h5", "r") as f:
-        spring = f["energy/spring"][...]
-        removed = f["energy/removed"][...]
-    assert abs(e.balance) < 1e-4                       # measured +6.3e-6 at 20 us
-    assert removed.min() >= 0.0                         # nothing made and booked as removed
-    assert spring.max() < 0.01                          # measured 6e-5 J (314 J before)
+    _, got = run_reduced(tmp_path, SEAMLESS_REDUCED)
+    assert abs(got["e"].balance) < 1e-4                # measured +6.3e-6 at 20 us
+    assert got["removed"].min() >= 0.0                  # nothing made and booked as removed
+    assert got["spring"].max() < 0.01                   # measured 6e-5 J (314 J before)
     assert got["peak"][got["cu"]].max() < 1000.0        # measured 458 m/s
 
 
