@@ -165,16 +165,16 @@ class Correspondence(Model):
                             families.nbr, self.omega_i, self.omega_j, self.rinv)
         # (n, 3, 3) C-contiguous: a point's tensor is 9 adjacent numbers in every kernel
         # (np.array of a broadcast keeps the broadcast's strides, point index fastest)
-        def eye():
-            return np.tile(np.eye(3), (n, 1, 1))
+        def eye(rows):
+            return np.tile(np.eye(3), (rows, 1, 1))
         self.Kinv = np.zeros((n, 3, 3))
         self.trK = np.zeros(n)
         self.spring = np.zeros(n, dtype=np.uint8)
-        self.F = eye()
-        self.F_old = eye()
+        self.F = eye(n)
+        self.F_old = eye(n)
         self.Fdot = np.zeros((n, 3, 3))
-        self.R = eye()
-        self.V = eye()
+        self.R = eye(n)
+        self.V = eye(n)
         self.sigma = np.zeros((n, 6))           # unrotated Cauchy stress, Voigt
         self.d = np.zeros((n, 6))               # unrotated rate of deformation, Voigt
         self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
@@ -189,8 +189,7 @@ class Correspondence(Model):
         self.fd = np.zeros((nl, FD_WIDTH_VISCOUS if viscosity is not None else FD_WIDTH))
         #: spring reference map of owned + ghost points (kernels.nosb): a point on the
         #: bond springs measures its bonds' stretch from |G xi|; set when it switches in
-        self.G = np.zeros((nl, 3, 3))
-        self.G[:] = np.eye(3)
+        self.G = eye(nl)
         self.dil = np.zeros(n if viscosity is not None else 0)
         if viscosity is not None:
             rho = np.array([m.density for m in mats])[points.material[:n]]
