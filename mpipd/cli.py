@@ -232,10 +232,12 @@ def _on_root(team, fn, *args):
         raise err
 
 
-def _over_dt(sim, team, scene) -> str | None:
+def _over_dt(sim, team, scene, failed: bool = False) -> str | None:
     """The multi-rate line on points whose stable step fell below dt in this
-    invocation (collective; None if none did, or single-rate)."""
-    return sim.classes.over_line(team, list(scene.materials)) if sim.classes.enabled else None
+    invocation (collective; None if none did, or single-rate; ``failed``: split at
+    the last frame, StepClasses.over_line)."""
+    return (sim.classes.over_line(team, list(scene.materials), failed)
+            if sim.classes.enabled else None)
 
 
 def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
@@ -293,7 +295,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
                        checkpointer=checkpointer)
     except Unstable as e:
         writer.close()
-        over = _over_dt(sim, team, scene)
+        over = _over_dt(sim, team, scene, failed=True)
         log(f"mpipd: error: {e}; state saved in {checkpointer.written}"
             + (f"; {over}" if over else ""), error=True)
         return EXIT_UNSTABLE

@@ -476,6 +476,7 @@ class Simulation:
             if frame:
                 e = writer.frame(self)              # the frame that broke it is kept
                 self._or_stop(lambda: self.check_ledger(e), checkpointer)
+                self.classes.frame_written(self.step_count)
             if not self.at_boundary:        # states of coarse classes are mid-step
                 continue
             if progress is not None:

@@ -308,6 +308,34 @@ def test_a_thinned_point_takes_a_finer_class_and_one_beyond_dt_is_named():
     assert f"{names[sim.points.material[900]]} 0.500 dt at gid {int(sim.points.gid[900])}" in line
 
 
+def test_a_failures_line_keeps_the_smallest_step_up_to_the_last_frame_apart():
+    """After a failure the over-dt line gives each material's smallest dt_i / dt up to
+    the last frame written apart from the steps after it, where a blow-up's inverted
+    or crushed points take dt_i towards 0; without a failure, or before any frame,
+    it is the one smallest of the invocation."""
+    dt = 1e-8
+    scene, _ = sc.load("elastic_wave", BAR + [f"time.dt={dt}", "time.t_end=1.6e-6",
+                                               "time.multirate={max_ratio=8, safety=1.0}"])
+    sim = Simulation(scene, _team())
+    cl, corr = sim.classes, sim.corr
+    names = list(scene.materials)
+    r0 = cl.dtc[0] * cl.cp0[0] / C_P / dt * cl.safety
+    name = names[sim.points.material[0]]
+    corr.V[100] = np.diag([1.0, 0.5 / r0, 1.0])                  # dt_i = 0.5 dt
+    cl.base_classes(corr, sim.halo, step=8)
+    cl.frame_written(16)
+    corr.V[300] = np.diag([1.0, 0.01 / r0, 1.0])                 # then 0.01 dt
+    cl.base_classes(corr, sim.halo, step=24)
+    g100, g300 = int(sim.points.gid[100]), int(sim.points.gid[300])
+    plain = cl.over_line(sim.team, names)
+    assert f"smallest: {name} 0.010 dt at gid {g300}." in plain
+    split = cl.over_line(sim.team, names, failed=True)
+    assert (f"smallest up to the last frame (step 16): {name} 0.500 dt at gid {g100}; "
+            f"with the steps after it, to the failure: {name} 0.010 dt at gid {g300}.") in split
+    cl.over_framed = None                                       # no frame in this invocation
+    assert cl.over_line(sim.team, names, failed=True) == plain
+
+
 def bar_at_rest_ratio(r0, ratio, factor="row_sum", more=""):
     """The bar with classes from the state (safety 1, family factor ``factor``, further
     multirate keys ``more``) and dt set so that every point's ratio at rest is ``r0``."""

@@ -186,6 +186,9 @@ class StepClasses:
         self.over_first = -1
         self.over_worst = {}                            # material id -> (dt_i / dt, gid)
         self.over_now = 0                               # points over dt at the last boundary
+        #: the three figures above as they stood at the last frame written (its step
+        #: last): a failure's line separates them from the steps of the blow-up itself
+        self.over_framed = None
         #: family_factor: its reference (1/lambda_min(K^0), or R^0), the factor kept, the
         #: rows to recompute; the row sum's element data (owned and ghosts) and R now
         self.kref = self.kfac = self.stale = None
@@ -369,24 +372,36 @@ class StepClasses:
             if ratio[w] < self.over_worst.get(int(m), (np.inf,))[0]:
                 self.over_worst[int(m)] = (float(ratio[w]), int(gid[w]))
 
-    def over_line(self, team, names) -> str | None:
+    def frame_written(self, step: int):
+        """Keep this rank's over-dt figures as they stand at a frame (step ``step``):
+        a failure's line reports the smallest stable steps up to that state apart
+        from those of the steps after it, where an instability may set them."""
+        self.over_framed = (self.over_steps, self.over_first, dict(self.over_worst), step)
+
+    def over_line(self, team, names, failed: bool = False) -> str | None:
         """One line (collective) on the points whose stable step fell below dt in this
         invocation, or None if none did: since when, how often, and the smallest
-        dt_i / dt of each material (``names``: by material id) with its point."""
+        dt_i / dt of each material (``names``: by material id) with its point.  After
+        a failure (``failed``) the smallest are given up to the last frame written
+        and, apart, over the steps after it: a blow-up's own steps (an inverted F)
+        take dt_i to 0 and would otherwise stand for the whole run."""
         got = team.gather((self.over_steps, self.over_first, self.over_worst))
+        kept = team.gather(self.over_framed) if failed else None
         hit = [g for g in got if g[0]]
         if not hit:
             return None
         first = min(g[1] for g in hit)
-        worst = {}
-        for g in hit:
-            for m, w in g[2].items():
-                worst[m] = min(worst.get(m, w), w)
-        each = "; ".join(f"{names[m]} {w[0]:.3f} dt at gid {w[1]}" for m, w in sorted(worst.items()))
+        each = ": " + _smallest(hit, names)
+        if failed and kept and all(k is not None for k in kept):
+            step = kept[0][3]
+            before = [k for k in kept if k[0]]
+            each = (f" up to the last frame (step {step}): "
+                    f"{_smallest(before, names) if before else 'none below dt'}; "
+                    f"with the steps after it, to the failure{each}")
         return (f"the step dt = {self.dt:.4g} s was above the stable step now of some points "
                 f"(their P-wave speed at their compression over their smallest principal "
                 f"stretch, mpipd.model.multirate) from step {first} on, at up to "
-                f"{max(g[0] for g in hit)} coarse steps; smallest: {each}. A smaller "
+                f"{max(g[0] for g in hit)} coarse steps; smallest{each}. A smaller "
                 f"time.dt with a larger max_ratio keeps the coarse step")
 
     def classify(self, corr, halo, step: int) -> bool:
@@ -492,6 +507,16 @@ class StepClasses:
             sel = k == c
             out[c] = (int(sel.sum()), int(n_bonds_of[sel].sum()))
         return out
+
+
+def _smallest(got, names) -> str:
+    """"copper 0.500 dt at gid 17; ..." from the ranks' (steps, first, worst by
+    material) of StepClasses.over_line: each material's smallest dt_i / dt."""
+    worst = {}
+    for g in got:
+        for m, w in g[2].items():
+            worst[m] = min(worst.get(m, w), w)
+    return "; ".join(f"{names[m]} {w[0]:.3f} dt at gid {w[1]}" for m, w in sorted(worst.items()))
 
 
 def shape_tensor_factor(cl, corr, halo, first: bool):
