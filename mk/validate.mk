@@ -67,6 +67,10 @@
 #   the physics of both is c008304's, notes §37): mpirun -n 2 mpipd run blast_paper:dx0.7
 #   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_dx0.7,
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_dx0.7/checkpoint.h5
+# blast_paper_gas_contact (eb82169 to step 3080, stopped with SIGUSR1 for `make bench`, then resumed at 307754a, whose
+#   mpipd/ changes only the failure line's text of the over-dt warning; the case at dt 5e-9 s, max_ratio 8, notes §42):
+#   mpirun -n 2 mpipd run blast_paper:gas_contact --out runs/blast_paper_gas_contact,
+#   then mpirun -n 2 mpipd run --restart runs/blast_paper_gas_contact/checkpoint.h5
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -76,7 +80,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_case3/run.h5 runs/blast_paper_case4/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
-    runs/blast_paper_dx1.2_gas_contact/run.h5 \
+    runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
