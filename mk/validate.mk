@@ -94,10 +94,23 @@ validate: install
 # `make diagnoses`: the cheaper runs behind docs/validation_notes.md's diagnoses, each
 # changing one thing, and their tables under docs/diagnoses/ (a run file that exists
 # under runs/diag/ is reused; delete it to run it again).
+# The crushed zone (notes §43): the slab to 16 us with close frames of pressure and
+# failure mode, as it is and with one change each (a linear EOS; JH2's T doubled, a
+# diagnosis, not a case), each read by failure_pressure.py.
+FAILP_RUN = run blast_paper:slab --set time.t_end=1.6e-5 --set output.every=4 \
+	--set 'output.fields=["pressure","failure_mode","damage"]' --set output.checkpoint_every=0
+FAILP_slab_failp_linear = --set materials.granite.K2=0.0 --set materials.granite.K3=0.0
+FAILP_slab_failp_T108 = --set materials.granite.T=108e6
+FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
+
 .PHONY: diagnoses
 diagnoses: install
 	$(PY) benchmarks/diagnoses/wave_speed.py --study --mpirun "$(MPIRUN)" \
 	    --out docs/diagnoses/wave_ring_elastic.md
+	$(foreach c,$(FAILP_CASES),{ test -f runs/diag/$(c)/run.h5 || $(MPIRUN) -n 2 \
+	    $(VENV)/bin/mpipd $(FAILP_RUN) $(FAILP_$(c)) --out runs/diag/$(c); } && \
+	    $(PY) benchmarks/diagnoses/failure_pressure.py runs/diag/$(c)/run.h5 \
+	    > docs/diagnoses/failure_pressure_$(c).txt &&) true
 
 # compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
 # `make sensitivity`, `make model-cases` and `make resolution` — the base row beside every

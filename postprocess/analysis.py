@@ -69,7 +69,7 @@ def _fracture(data_sections, model, last) -> dict:
         args = (sec["x"], sec["y"], failed, model.center, sec["h"], model.r_wall, model.r_out)
         out[name] = {"z_mm": z * 1e3, "zones": cracks.crack_density(*args),
                      "radial_cracks": cracks.radial_cracks(*args, horizon=sec["link"]),
-                     "crushed_zone": cracks.crushed_zone(*args),
+                     "crushed_zone": cracks.crushed_zone(*args, mode=sec.get(("failure_mode", last))),
                      "orientation": crack_orientation.measure(*args, horizon=sec["link"])}
     names = [n for n in CRACK_SECTIONS if n in out]
     dens = [[out[n]["zones"][k]["density_mm_per_mm2"] for n in names] for k in range(3)]

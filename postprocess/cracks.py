@@ -32,13 +32,18 @@ borehole are damaged").  The failed fraction is taken in rings of width dx from
 the wall outward; the crushed zone ends at the outer edge of the last ring of
 the unbroken run from the wall in which at least 90 % of the points have
 failed (dx of the finest zone).  Its extent d_c = r_c - R_b is reported, also in
-borehole radii.
+borehole radii.  The paper counts every damaged point, whatever broke it; so does the
+measure.  Given the points' failure modes, it also reports the share of each mode among
+the failed points of its rings: whether the zone was crushed in compression (JH2
+plastic, D >= 1) or cracked densely in tension (the tension model).
 
 Every function takes ``dx`` (and ``horizon``) as one number or as one per point.
 """
 from __future__ import annotations
 
 import numpy as np
+
+from mpipd.kernels.layout import MODE_LABELS, N_MODES
 
 FAILED_PHI = 1.0 - 1e-9
 CRUSH_FRACTION = 0.9
@@ -164,11 +169,21 @@ def crushed_rings(frac) -> int:
     return run
 
 
-def crushed_zone(x, y, failed, center, dx, r_wall, r_out) -> dict:
-    """Outer radius of the unbroken run of >= 90 % failed rings from the wall."""
-    frac, dx = ring_fractions(x, y, failed, center, dx, r_wall, r_out)
+def crushed_zone(x, y, failed, center, dx, r_wall, r_out, mode=None) -> dict:
+    """Outer radius of the unbroken run of >= 90 % failed rings from the wall; with
+    ``mode`` (each point's failure mode, mpipd.kernels.layout), the share of each mode
+    among the failed points of those rings (``mode_share``; empty when the run is)."""
+    frac, w = ring_fractions(x, y, failed, center, dx, r_wall, r_out)
     run = crushed_rings(frac)
-    rc = r_wall + run * dx
-    return {"r_c_mm": rc * 1e3, "extent_mm": (rc - r_wall) * 1e3,
-            "extent_borehole_radii": (rc - r_wall) / r_wall,
-            "failed_fraction_by_ring": np.nan_to_num(frac[:max(run + 3, 1)]).round(4).tolist()}
+    rc = r_wall + run * w
+    out = {"r_c_mm": rc * 1e3, "extent_mm": (rc - r_wall) * 1e3,
+           "extent_borehole_radii": (rc - r_wall) / r_wall,
+           "failed_fraction_by_ring": np.nan_to_num(frac[:max(run + 3, 1)]).round(4).tolist()}
+    if mode is not None:
+        k = ring_index(x, y, center, w, r_wall, r_out)[0]
+        inside = (k < run) & np.asarray(failed, bool)
+        cnt = np.bincount(np.clip(np.asarray(mode, int)[inside], 0, N_MODES - 1),
+                          minlength=N_MODES)
+        out["mode_share"] = ({MODE_LABELS[i]: float(cnt[i] / cnt.sum()) for i in range(N_MODES)}
+                             if cnt.sum() else {})
+    return out

@@ -144,6 +144,13 @@ def _fracture(fr) -> list[str]:
           f"{fr['major_radial_cracks']:.3g} (median) | {fr['crushed_extent_mm']:.3g} / "
           f"{fr['crushed_extent_borehole_radii']:.2f} |",
           "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", ""]
+    shares = [(name, s["crushed_zone"].get("mode_share")) for name, s in fr["sections"].items()]
+    if any(m for _, m in shares):
+        L += ["What failed the crushed zone's points (share of its failed points by the "
+              "point's own failure mode; 'intact': every bond broken by its neighbours' "
+              "failure): " + "; ".join(
+                  f"{name}: " + ", ".join(f"{k} {v:.2f}" for k, v in m.items() if v)
+                  for name, m in shares if m) + ".", ""]
     return L
 
 

@@ -191,6 +191,32 @@ def test_a_wide_spall_band_is_a_failed_ring_and_the_crushed_zone_is_not():
     assert m["zones"][2]["unresolved"]["points"] > 0.5 * np.count_nonzero(band)
 
 
+def test_the_crushed_zone_reports_what_failed_its_points():
+    """A disc crushed to 7.2 mm (five rings of dx beyond the 3.2 mm wall): JH2 plastic
+    (mode 1) inside 5.6 mm, the tension model (mode 3) beyond, one point there whose bonds
+    all broke with its own state intact (mode 0), and tension rays past the disc that
+    are not the crushed zone's: the shares are the counts by radius."""
+    x, y = _section()
+    r = np.hypot(x, y)
+    disc = r < 7.2e-3
+    failed = disc | _rays(x, y, np.arange(0, 360, 45))
+    mode = np.where(failed, np.where(r < 5.6e-3, 1, 3), 0)
+    lone = np.flatnonzero(disc & (r > 6.4e-3))[0]
+    mode[lone] = 0
+    crushed = cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, mode=mode)
+    assert crushed["extent_mm"] == pytest.approx(4.0)
+    n = np.count_nonzero(disc)
+    share = crushed["mode_share"]
+    assert share["JH2 plastic (D >= 1)"] == pytest.approx(np.count_nonzero(r < 5.6e-3) / n)
+    assert share["tension model (Eq. 38)"] == pytest.approx(
+        (np.count_nonzero(disc & (r >= 5.6e-3)) - 1) / n)
+    assert share["intact"] == pytest.approx(1 / n) and share["JH2 tensile (p < -T)"] == 0.0
+    assert "mode_share" not in cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT)
+    none = cracks.crushed_zone(x, y, np.zeros(len(x), bool), (0.0, 0.0), DX, R_WALL, R_OUT,
+                               mode=mode)
+    assert none["extent_mm"] == 0.0 and none["mode_share"] == {}
+
+
 def test_a_complete_ring_two_points_wide_is_a_failed_ring():
     x, y = _section()
     r = np.hypot(x, y)

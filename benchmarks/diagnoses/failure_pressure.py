@@ -1,0 +1,104 @@
+"""What fails the rock near the borehole: the pressure each rock point held just before
+it failed, by failure mode and ring, and what failed the crushed zone's points.
+
+Diagnosis of docs/validation_notes.md §43 (the crushed zone: compression or tension?).
+From a run file, serially (rank 0 of the run file's reader; run it on 1 rank):
+
+* **Crushed zone by mode** (every frame's last, the report's three crack sections):
+  postprocess.cracks.crushed_zone with the points' failure modes — the share of JH2
+  plastic (D >= 1), JH2 tensile and tension-model failures among the failed points of
+  its rings.
+* **Pressure before failure** (needs ``failure_mode`` and ``pressure`` at frames close
+  together, e.g. ``--set output.every=4 --set 'output.fields=["pressure",
+  "failure_mode","damage"]'``): for each rock point that failed, the pressure p
+  (compression positive) at the last frame before the one where its failure mode is
+  first set (a failed point's pressure is zeroed, so that frame holds 0); by failure
+  mode and by ring of width dx from the wall, the median p, the share with p < 0 and
+  the median failure time.  The pressure is the state up to ``output.every`` steps
+  before the failure.
+
+    mpirun -n 1 python benchmarks/diagnoses/failure_pressure.py RUN.h5 [--rings 14]
+"""
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from mpipd.kernels.layout import MODE_NAMES  # noqa: E402
+from postprocess import cracks  # noqa: E402
+from postprocess import sections as secs  # noqa: E402
+from postprocess.analysis import CRACK_SECTIONS  # noqa: E402
+from postprocess.model import load_model  # noqa: E402
+from postprocess.reader import Run  # noqa: E402
+
+
+def crushed_by_mode(run, model, last):
+    named = secs.named_levels(secs.zone_levels(run, model), model)
+    want = {n: z for n, z in named.items() if n in CRACK_SECTIONS}
+    data = secs.gather_sections(run, model, want, [("damage", last), ("failure_mode", last)])
+    print(f"crushed zone at t = {run.time[last] * 1e6:.2f} us, by the failure mode of its "
+          "failed points:")
+    for name, sec in data.items():
+        failed, _ = cracks.failed_points(sec, last)
+        c = cracks.crushed_zone(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                model.r_wall, model.r_out, mode=sec[("failure_mode", last)])
+        share = ", ".join(f"{k} {v:.3f}" for k, v in c.get("mode_share", {}).items() if v)
+        print(f"  {name}: {c['extent_mm']:.2f} mm ({c['extent_borehole_radii']:.2f} R_b); "
+              f"{share or 'no crushed ring'}")
+
+
+def pressure_before_failure(run, model, rings):
+    rock = np.flatnonzero(model.is_rock(run.geometry("part")))
+    r = model.radius(run.geometry("x")[rock])
+    frames = run.frames
+    mode = np.stack([run.field("failure_mode", k)[rock] for k in range(frames)]).astype(int)
+    p = np.stack([run.field("pressure", k)[rock] for k in range(frames)])
+    t = np.asarray(run.time)
+    first = np.where((mode != 0).any(axis=0), (mode != 0).argmax(axis=0), -1)
+    dx = model.wall_dx or model.dx
+    ring = ((r - model.r_wall) / dx).astype(int)
+    every = (t[1] - t[0]) * 1e6 if frames > 1 else float("nan")
+    print(f"\npressure before failure: {frames} frames {every:.3g} us apart; "
+          f"{len(rock)} rock points, {np.count_nonzero(first >= 0)} failed")
+    for code in sorted(set(np.unique(mode[-1]).tolist()) - {0}):
+        q = np.flatnonzero((first > 0) & (mode[-1] == code))
+        if not len(q):
+            continue
+        pb = p[first[q] - 1, q]
+        print(f"\n{MODE_NAMES[code]}: {len(q)} points, p before failure median "
+              f"{np.median(pb) / 1e6:.1f} MPa, share p < 0 {np.mean(pb < 0):.3f}")
+        print("  ring (R_b beyond the wall)  points  median p (MPa)  share p < 0  median t (us)")
+        for k in range(rings):
+            s = q[ring[q] == k]
+            if len(s) < 5:
+                continue
+            ps = p[first[s] - 1, s]
+            print(f"  {k * dx / model.r_wall:4.2f}-{(k + 1) * dx / model.r_wall:4.2f}"
+                  f"  {len(s):6d}  {np.median(ps) / 1e6:9.1f}  {np.mean(ps < 0):10.3f}"
+                  f"  {np.median(t[first[s]]) * 1e6:9.2f}")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("run_file")
+    ap.add_argument("--rings", type=int, default=14)
+    args = ap.parse_args()
+    if MPI.COMM_WORLD.size != 1:
+        sys.exit("failure_pressure.py runs on 1 rank")
+    run = Run(args.run_file, MPI.COMM_WORLD)
+    model = load_model(run)
+    commit = run.f.attrs.get("git_commit", "unknown")
+    print(f"# {args.run_file}: {model.scene_name} at {commit}, overrides "
+          f"{' '.join(model.overrides) or 'none'}\n")
+    crushed_by_mode(run, model, run.frames - 1)
+    if run.has_field("pressure") and run.has_field("failure_mode"):
+        pressure_before_failure(run, model, args.rings)
+    else:
+        print("\nno pressure or failure_mode field: no pressure before failure")
+
+
+if __name__ == "__main__":
+    main()
