@@ -107,10 +107,11 @@ FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
 diagnoses: install
 	$(PY) benchmarks/diagnoses/wave_speed.py --study --mpirun "$(MPIRUN)" \
 	    --out docs/diagnoses/wave_ring_elastic.md
-	$(foreach c,$(FAILP_CASES),{ test -f runs/diag/$(c)/run.h5 || $(MPIRUN) -n 2 \
+	$(foreach c,$(FAILP_CASES),{ test -f runs/diag/$(c)/run.h5 || $(MPIRUN) -n 1 \
 	    $(VENV)/bin/mpipd $(FAILP_RUN) $(FAILP_$(c)) --out runs/diag/$(c); } && \
 	    $(PY) benchmarks/diagnoses/failure_pressure.py runs/diag/$(c)/run.h5 \
-	    > docs/diagnoses/failure_pressure_$(c).txt &&) true
+	    > runs/diag/$(c)/failure_pressure.txt && \
+	    cp runs/diag/$(c)/failure_pressure.txt docs/diagnoses/failure_pressure_$(c).txt &&) true
 
 # compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
 # `make sensitivity`, `make model-cases` and `make resolution` — the base row beside every

@@ -180,10 +180,13 @@ def crushed_zone(x, y, failed, center, dx, r_wall, r_out, mode=None) -> dict:
            "extent_borehole_radii": (rc - r_wall) / r_wall,
            "failed_fraction_by_ring": np.nan_to_num(frac[:max(run + 3, 1)]).round(4).tolist()}
     if mode is not None:
+        mode = np.asarray(mode, int)
+        if len(mode) and not (0 <= mode.min() and mode.max() < N_MODES):
+            raise ValueError(f"failure modes must lie in 0..{N_MODES - 1} "
+                             f"(got {mode.min()}..{mode.max()})")
         k = ring_index(x, y, center, w, r_wall, r_out)[0]
         inside = (k < run) & np.asarray(failed, bool)
-        cnt = np.bincount(np.clip(np.asarray(mode, int)[inside], 0, N_MODES - 1),
-                          minlength=N_MODES)
+        cnt = np.bincount(mode[inside], minlength=N_MODES)
         out["mode_share"] = ({MODE_LABELS[i]: float(cnt[i] / cnt.sum()) for i in range(N_MODES)}
                              if cnt.sum() else {})
     return out

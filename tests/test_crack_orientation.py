@@ -194,8 +194,9 @@ def test_a_wide_spall_band_is_a_failed_ring_and_the_crushed_zone_is_not():
 def test_the_crushed_zone_reports_what_failed_its_points():
     """A disc crushed to 7.2 mm (five rings of dx beyond the 3.2 mm wall): JH2 plastic
     (mode 1) inside 5.6 mm, the tension model (mode 3) beyond, one point there whose bonds
-    all broke with its own state intact (mode 0), and tension rays past the disc that
-    are not the crushed zone's: the shares are the counts by radius."""
+    all broke with its own state intact (mode 0), one point in the innermost ring that did
+    not fail (it does not count), and tension rays past the disc that are not the crushed
+    zone's: the shares are the counts by radius."""
     x, y = _section()
     r = np.hypot(x, y)
     disc = r < 7.2e-3
@@ -203,14 +204,19 @@ def test_the_crushed_zone_reports_what_failed_its_points():
     mode = np.where(failed, np.where(r < 5.6e-3, 1, 3), 0)
     lone = np.flatnonzero(disc & (r > 6.4e-3))[0]
     mode[lone] = 0
+    whole = np.flatnonzero(disc & (r < 4.0e-3))[0]     # one of about 28 in its ring
+    failed[whole] = False
+    mode[whole] = 0
     crushed = cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, mode=mode)
     assert crushed["extent_mm"] == pytest.approx(4.0)
-    n = np.count_nonzero(disc)
+    n = np.count_nonzero(disc) - 1
     share = crushed["mode_share"]
-    assert share["JH2 plastic (D >= 1)"] == pytest.approx(np.count_nonzero(r < 5.6e-3) / n)
+    assert share["JH2 plastic (D >= 1)"] == pytest.approx((np.count_nonzero(r < 5.6e-3) - 1) / n)
     assert share["tension model (Eq. 38)"] == pytest.approx(
         (np.count_nonzero(disc & (r >= 5.6e-3)) - 1) / n)
     assert share["intact"] == pytest.approx(1 / n) and share["JH2 tensile (p < -T)"] == 0.0
+    with pytest.raises(ValueError, match="failure modes"):
+        cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT, mode=mode + 4)
     assert "mode_share" not in cracks.crushed_zone(x, y, failed, (0.0, 0.0), DX, R_WALL, R_OUT)
     none = cracks.crushed_zone(x, y, np.zeros(len(x), bool), (0.0, 0.0), DX, R_WALL, R_OUT,
                                mode=mode)

@@ -4,7 +4,7 @@ it failed, by failure mode and ring, and what failed the crushed zone's points.
 Diagnosis of docs/validation_notes.md §43 (the crushed zone: compression or tension?).
 From a run file, serially (rank 0 of the run file's reader; run it on 1 rank):
 
-* **Crushed zone by mode** (every frame's last, the report's three crack sections):
+* **Crushed zone by mode** (the last frame, on the report's three crack sections):
   postprocess.cracks.crushed_zone with the points' failure modes — the share of JH2
   plastic (D >= 1), JH2 tensile and tension-model failures among the failed points of
   its rings.
@@ -14,8 +14,10 @@ From a run file, serially (rank 0 of the run file's reader; run it on 1 rank):
   (compression positive) at the last frame before the one where its failure mode is
   first set (a failed point's pressure is zeroed, so that frame holds 0); by failure
   mode and by ring of width dx from the wall, the median p, the share with p < 0 and
-  the median failure time.  The pressure is the state up to ``output.every`` steps
-  before the failure.
+  the median failure time; the points beyond the last ring are summed in one row.  The
+  pressure is the state up to ``output.every`` steps before the failure; points failed
+  at the first frame have no state before it and are counted apart.  ``--crushed-only``
+  skips this part (a run whose frames are microseconds apart).
 
     mpirun -n 1 python benchmarks/diagnoses/failure_pressure.py RUN.h5 [--rings 14]
 """
@@ -39,6 +41,9 @@ def crushed_by_mode(run, model, last):
     named = secs.named_levels(secs.zone_levels(run, model), model)
     want = {n: z for n, z in named.items() if n in CRACK_SECTIONS}
     data = secs.gather_sections(run, model, want, [("damage", last), ("failure_mode", last)])
+    if not all(("failure_mode", last) in sec for sec in data.values()):
+        print("no failure_mode field: no crushed zone by mode")
+        return
     print(f"crushed zone at t = {run.time[last] * 1e6:.2f} us, by the failure mode of its "
           "failed points:")
     for name, sec in data.items():
@@ -52,17 +57,18 @@ def crushed_by_mode(run, model, last):
 
 def pressure_before_failure(run, model, rings):
     rock = np.flatnonzero(model.is_rock(run.geometry("part")))
-    r = model.radius(run.geometry("x")[rock])
+    x = run.geometry("x")[rock]
     frames = run.frames
     mode = np.stack([run.field("failure_mode", k)[rock] for k in range(frames)]).astype(int)
     p = np.stack([run.field("pressure", k)[rock] for k in range(frames)])
     t = np.asarray(run.time)
     first = np.where((mode != 0).any(axis=0), (mode != 0).argmax(axis=0), -1)
-    dx = model.wall_dx or model.dx
-    ring = ((r - model.r_wall) / dx).astype(int)
+    ring, _, dx = cracks.ring_index(x[:, 0], x[:, 1], model.center, model.wall_dx,
+                                    model.r_wall, model.r_out)
     every = (t[1] - t[0]) * 1e6 if frames > 1 else float("nan")
     print(f"\npressure before failure: {frames} frames {every:.3g} us apart; "
-          f"{len(rock)} rock points, {np.count_nonzero(first >= 0)} failed")
+          f"{len(rock)} rock points, {np.count_nonzero(first > 0)} failed after the first "
+          f"frame, {np.count_nonzero(first == 0)} at it")
     for code in sorted(set(np.unique(mode[-1]).tolist()) - {0}):
         q = np.flatnonzero((first > 0) & (mode[-1] == code))
         if not len(q):
@@ -71,13 +77,14 @@ def pressure_before_failure(run, model, rings):
         print(f"\n{MODE_NAMES[code]}: {len(q)} points, p before failure median "
               f"{np.median(pb) / 1e6:.1f} MPa, share p < 0 {np.mean(pb < 0):.3f}")
         print("  ring (R_b beyond the wall)  points  median p (MPa)  share p < 0  median t (us)")
-        for k in range(rings):
-            s = q[ring[q] == k]
+        for k in range(rings + 1):
+            s = q[ring[q] == k] if k < rings else q[ring[q] >= rings]
             if len(s) < 5:
                 continue
             ps = p[first[s] - 1, s]
-            print(f"  {k * dx / model.r_wall:4.2f}-{(k + 1) * dx / model.r_wall:4.2f}"
-                  f"  {len(s):6d}  {np.median(ps) / 1e6:9.1f}  {np.mean(ps < 0):10.3f}"
+            span = (f"{k * dx / model.r_wall:4.2f}-{(k + 1) * dx / model.r_wall:4.2f}" if k < rings
+                    else f"beyond {k * dx / model.r_wall:4.2f}")
+            print(f"  {span}  {len(s):6d}  {np.median(ps) / 1e6:9.1f}  {np.mean(ps < 0):10.3f}"
                   f"  {np.median(t[first[s]]) * 1e6:9.2f}")
 
 
@@ -85,15 +92,18 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("run_file")
     ap.add_argument("--rings", type=int, default=14)
+    ap.add_argument("--crushed-only", action="store_true")
     args = ap.parse_args()
     if MPI.COMM_WORLD.size != 1:
         sys.exit("failure_pressure.py runs on 1 rank")
     run = Run(args.run_file, MPI.COMM_WORLD)
     model = load_model(run)
-    commit = run.f.attrs.get("git_commit", "unknown")
+    commit = run.attr("git_commit", "unknown")
     print(f"# {args.run_file}: {model.scene_name} at {commit}, overrides "
           f"{' '.join(model.overrides) or 'none'}\n")
     crushed_by_mode(run, model, run.frames - 1)
+    if args.crushed_only:
+        return
     if run.has_field("pressure") and run.has_field("failure_mode"):
         pressure_before_failure(run, model, args.rings)
     else:
