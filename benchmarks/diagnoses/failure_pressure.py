@@ -4,6 +4,7 @@ it failed, by failure mode and ring, and what failed the crushed zone's points.
 Diagnosis of docs/validation_notes.md §43 (the crushed zone: compression or tension?).
 From a run file, serially (rank 0 of the run file's reader; run it on 1 rank):
 
+* **The wall probe's peaks**, every step (what the wall layer carried), if it has one.
 * **Crushed zone by mode** (the last frame, on the report's three crack sections):
   postprocess.cracks.crushed_zone with the points' failure modes — the share of JH2
   plastic (D >= 1), JH2 tensile and tension-model failures among the failed points of
@@ -102,6 +103,10 @@ def main():
     print(f"# {args.run_file}: {model.scene_name} at {commit}, overrides "
           f"{' '.join(model.overrides) or 'none'}\n")
     crushed_by_mode(run, model, run.frames - 1)
+    if "probes/wall" in run.f:
+        srr, p, vr = (run.f[f"probes/wall/{k}"][()] for k in ("sigma_rr", "p", "v_r"))
+        print(f"  probe wall (every step): peak -sigma_rr {-srr.min() / 1e6:.1f} MPa, "
+              f"peak pressure {p.max() / 1e6:.1f} MPa, peak |v_r| {np.abs(vr).max():.2f} m/s")
     if args.crushed_only:
         return
     if run.has_field("pressure") and run.has_field("failure_mode"):
