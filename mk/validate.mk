@@ -71,6 +71,10 @@
 #   mpipd/ changes only the failure line's text of the over-dt warning; the case at dt 5e-9 s, max_ratio 8, notes §42):
 #   mpirun -n 2 mpipd run blast_paper:gas_contact --out runs/blast_paper_gas_contact,
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_gas_contact/checkpoint.h5
+# blast_paper_seamless (started at 394558f, stopped with SIGUSR1 at steps 400 and 4800, resumed at 394558f and at
+#   77b4891, whose mpipd/ is 394558f's: one physics throughout; the case at dt 1e-8 s, max_ratio 8, notes §44):
+#   mpirun -n 2 mpipd run blast_paper:seamless --out runs/blast_paper_seamless,
+#   then mpirun -n 2 mpipd run --restart runs/blast_paper_seamless/checkpoint.h5 (twice)
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -80,7 +84,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_case3/run.h5 runs/blast_paper_case4/run.h5 runs/blast_paper_case5/run.h5 runs/blast_paper_case6/run.h5 \
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
-    runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 \
+    runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
@@ -102,6 +106,10 @@ FAILP_RUN = run blast_paper:slab --set time.t_end=1.6e-5 --set output.every=4 \
 FAILP_slab_failp_linear = --set materials.granite.K2=0.0 --set materials.granite.K3=0.0
 FAILP_slab_failp_T108 = --set materials.granite.T=108e6
 FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
+# on full rows (a row without its run file here is skipped with a line saying so): the
+# crushed zone by mode (--crushed-only: their frames are microseconds apart) and each
+# crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44)
+FAILP_ROWS = gas_contact seamless
 
 .PHONY: diagnoses
 diagnoses: install
@@ -112,6 +120,12 @@ diagnoses: install
 	    $(PY) benchmarks/diagnoses/failure_pressure.py runs/diag/$(c)/run.h5 \
 	    > runs/diag/$(c)/failure_pressure.txt && \
 	    cp runs/diag/$(c)/failure_pressure.txt docs/diagnoses/failure_pressure_$(c).txt &&) true
+	@for r in $(FAILP_ROWS); do f=runs/blast_paper_$$r/run.h5; \
+	    if test -f $$f; then echo "failure_pressure.py $$f --crushed-only"; \
+	    $(PY) benchmarks/diagnoses/failure_pressure.py $$f --crushed-only \
+	    > docs/diagnoses/failure_pressure_$$r.txt || exit 1; \
+	    $(PY) benchmarks/diagnoses/zone_split.py $$f > docs/diagnoses/zone_split_$$r.txt || exit 1; \
+	    else echo "skip $$r: no $$f (its command is above VALIDATE_RUNS)"; fi; done
 
 # compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
 # `make sensitivity`, `make model-cases` and `make resolution` — the base row beside every

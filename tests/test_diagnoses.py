@@ -83,3 +83,37 @@ def test_potentials_where_totals_are_the_ledgers_terms(tmp_path):
         assert sum(float(r[col]) for r in parts) == pytest.approx(float(whole[col]), rel=1e-3)
         assert float(whole[col]) == pytest.approx(booked, rel=1e-3, abs=1e-9)
     assert hg > 0
+
+
+def test_zone_split_reads_a_failed_annulus_as_area_over_dx():
+    """benchmarks/diagnoses/zone_split.py on a hand-built section: a square lattice at
+    0.3 mm inside r = 10 mm and 0.8 mm beyond (the seamless band's), the annulus 3.2-10
+    mm failed through and nothing else.  Its share of zone 1 is counted here as failed
+    points x dx over the zone's area, and it is within the lattice's rounding of
+    area(annulus) / (dx area(zone 1)); the part beyond 10 mm adds nothing, and the two
+    shares add up to crack_density's zone."""
+    spec = importlib.util.spec_from_file_location(
+        "zone_split", ROOT / "benchmarks" / "diagnoses" / "zone_split.py")
+    zs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(zs)
+    rw, ro, rs = 3.2e-3, 72e-3, 10e-3
+    fine = np.arange(-rs, rs + 1e-9, 0.3e-3)
+    coarse = np.arange(-ro, ro + 1e-9, 0.8e-3)
+    xf, yf = (a.ravel() for a in np.meshgrid(fine, fine))
+    xc, yc = (a.ravel() for a in np.meshgrid(coarse, coarse))
+    kf, kc = np.hypot(xf, yf) < rs, np.hypot(xc, yc) >= rs
+    x, y = np.concatenate([xf[kf], xc[kc]]), np.concatenate([yf[kf], yc[kc]])
+    dx = np.concatenate([np.full(kf.sum(), 0.3e-3), np.full(kc.sum(), 0.8e-3)])
+    r = np.hypot(x, y)
+    failed = (r >= rw) & (r < rs)
+    whole, parts, masks = zs.split_density(x, y, failed, (0.0, 0.0), dx, rw, ro, rs)
+    e1 = rw + (ro - rw) / 3
+    area1 = np.pi * (e1 ** 2 - rw ** 2)
+    by_hand = np.count_nonzero(failed) * 0.3 / (area1 * 1e6)     # mm / mm^2
+    assert parts[0][0]["density_mm_per_mm2"] == pytest.approx(by_hand, rel=1e-12)
+    assert by_hand == pytest.approx(np.pi * (rs ** 2 - rw ** 2) / (0.3e-3 * area1) * 1e-3, rel=0.03)
+    assert parts[1][0]["density_mm_per_mm2"] == 0.0
+    for k in range(3):
+        assert (parts[0][k]["density_mm_per_mm2"] + parts[1][k]["density_mm_per_mm2"]
+                == pytest.approx(whole[k]["density_mm_per_mm2"], rel=1e-12))
+    assert np.count_nonzero(masks[0][0]) == np.count_nonzero(kf & (np.hypot(xf, yf) >= rw))
