@@ -122,9 +122,12 @@ diagnoses: install
 	    cp runs/diag/$(c)/failure_pressure.txt docs/diagnoses/failure_pressure_$(c).txt &&) true
 	@for r in $(FAILP_ROWS); do f=runs/blast_paper_$$r/run.h5; \
 	    if test -f $$f; then echo "failure_pressure.py $$f --crushed-only"; \
+	    mkdir -p runs/diag/$$r || exit 1; \
 	    $(PY) benchmarks/diagnoses/failure_pressure.py $$f --crushed-only \
-	    > docs/diagnoses/failure_pressure_$$r.txt || exit 1; \
-	    $(PY) benchmarks/diagnoses/zone_split.py $$f > docs/diagnoses/zone_split_$$r.txt || exit 1; \
+	    > runs/diag/$$r/failure_pressure.txt || exit 1; \
+	    $(PY) benchmarks/diagnoses/zone_split.py $$f > runs/diag/$$r/zone_split.txt || exit 1; \
+	    cp runs/diag/$$r/failure_pressure.txt docs/diagnoses/failure_pressure_$$r.txt || exit 1; \
+	    cp runs/diag/$$r/zone_split.txt docs/diagnoses/zone_split_$$r.txt || exit 1; \
 	    else echo "skip $$r: no $$f (its command is above VALIDATE_RUNS)"; fi; done
 
 # compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
@@ -141,11 +144,13 @@ endef
 # `make sensitivity`: Table 3's cases (Fig. 22) at the paper's geometry, from the rows of
 # the record: the base scene (SENS_BASE, the default rule's full run) beside every case
 # row docs/validation/blast_paper_case<k>/ that exists, and the base run again at a later
-# commit (blast_paper_rerun, notes §36: the base's own shift), in
+# commit (blast_paper_rerun, notes §36: the base's own shift) and case 5 run again at a
+# later commit (blast_paper_case5_rerun, notes §45: its ring cracks), in
 # docs/sensitivity_blast_paper.md. A case row is made by its run (about an hour on 2
 # ranks; the commands are above), its report and `make validate` with it in VALIDATE_RUNS.
 SENS_BASE ?= docs/validation/blast_paper_index
-SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6]))
+SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6])) \
+    $(wildcard docs/validation/blast_paper_case5_rerun)
 SENS_OUT ?= docs/sensitivity_blast_paper.md
 .PHONY: sensitivity
 sensitivity: install

@@ -209,6 +209,8 @@ def target_values(m: dict) -> dict:
         "wave_speed": _get(m["wave_speed"], "speed_m_s"),
         "wave_speed_peak": _get(m["wave_speed"].get("peak_arrival", m["wave_speed"]),
                                 "speed_m_s"),
+        "wave_speed_first_pulse_peak": _get(m["wave_speed"].get(
+            "first_pulse_peak_arrival", m["wave_speed"]), "speed_m_s"),
         "peak_sigma_rr_A": _point(m["radial_stress"], "A", "peak_MPa"),
         "peak_sigma_rr_G": _point(m["radial_stress"], "G", "peak_MPa"),
         "attenuation_n": _get(m["radial_stress"], "fit", "n"),
@@ -231,10 +233,13 @@ def _bases(m: dict) -> dict:
     ns = len(fr.get("sections", {}))
     ws, rs = m["wave_speed"], m["radial_stress"]
     pa = ws.get("peak_arrival", {})
+    fp = ws.get("first_pulse_peak_arrival", {})
     out = {"wave_speed": f"{len(ws['probes'])} probes" if "probes" in ws else "",
            "wave_speed_peak": (f"{len(pa['probes'])} probes" if "probes" in pa else "")
            + (f"; later pulse at {', '.join(pa['later_pulse'])}" if pa.get("later_pulse")
               else ""),
+           "wave_speed_first_pulse_peak": (f"{len(fp['probes'])} probes" if "probes" in fp
+                                           else ""),
            "attenuation_n": (f"{rs['fit']['n_points']} probes"
                              if "fit" in rs and "n_points" in rs["fit"] else ""),
            "attenuation_n_first_pulse": (f"{rs['first_pulse_fit']['n_points']} probes"

@@ -221,6 +221,7 @@ def wave_speed(probes, radial: dict) -> dict:
         if "not_available" in fit:
             out["not_available"] += f"; peaks at the end of the record: {', '.join(late) or 'none'}"
     out["peak_arrival"] = _peak_arrival(pts, later)
+    out["first_pulse_peak_arrival"] = _first_pulse_peak_arrival(radial["points"])
     out["threshold_study"] = _threshold_study(probes, [r["name"] for r in rows],
                                               [r["d_mm"] * 1e-3 for r in rows])
     return out
@@ -260,6 +261,29 @@ def _peak_arrival(pts, later) -> dict:
         return {"not_available": why, "later_pulse": later, "note": note, "arrivals": rows}
     return {"speed_m_s": f["speed_m_s"], "r2": f["r2"], "probes": names,
             "later_pulse": later, "note": note, "arrivals": rows}
+
+
+def _first_pulse_peak_arrival(pts) -> dict:
+    """The paper's method on the direct wave (Fig. 16b: "the arrival time of the peak
+    stress ... the slope of the linear fitting line"): the slope of d against the time of
+    each probe's first-pulse peak (:func:`_first_pulse_peak`), the wave the paper's
+    peaks belong to ("a series of stress waves with reducing magnitude", §3.3).  A probe
+    without a first-pulse peak is left out with its reason; times that do not increase
+    with distance give no speed, as in :func:`_peak_arrival`."""
+    have = [p for p in pts if p.get("t_first_pulse_peak_us") is not None]
+    left = {p["name"]: p["first_pulse_peak_MPa"]["not_available"] for p in pts
+            if p.get("t_first_pulse_peak_us") is None
+            and isinstance(p.get("first_pulse_peak_MPa"), dict)}
+    rows = [{"name": p["name"], "d_mm": p["d_mm"], "t_us": p["t_first_pulse_peak_us"]}
+            for p in have]
+    f = arrivals.speed([p["name"] for p in have], [p["d_mm"] * 1e-3 for p in have],
+                       [p["t_first_pulse_peak_us"] * 1e-6 for p in have])
+    if "speed_m_s" not in f:
+        why = f.get("error", f.get("not_available", "")).replace("first-arrival",
+                                                                 "first-pulse peak")
+        return {"not_available": why, "excluded": left, "arrivals": rows}
+    return {"speed_m_s": f["speed_m_s"], "r2": f["r2"], "probes": [r["name"] for r in rows],
+            "excluded": left, "arrivals": rows}
 
 
 def ppv(probes) -> dict:

@@ -272,6 +272,15 @@ def _speeds(w) -> list[str]:
              + (f"not available: {pa['not_available']}" if _na(pa) else
                 f"{pa['speed_m_s']:.0f} m/s (R² {pa['r2']:.3f})")
              + f" (paper 4270 m/s); {pa.get('note', '')}.")
+    fp = w.get("first_pulse_peak_arrival")
+    if fp is not None:
+        L.append("The same method on the direct wave (arrival time of each probe's "
+                 "first-pulse peak, information only): "
+                 + (f"not available: {fp['not_available']}" if _na(fp) else
+                    f"{fp['speed_m_s']:.0f} m/s (R² {fp['r2']:.3f}, probes "
+                    f"{', '.join(fp['probes'])})")
+                 + ("; left out: " + "; ".join(f"{k} ({v})" for k, v in fp["excluded"].items())
+                    if fp.get("excluded") else "") + ".")
     ts = w.get("threshold_study", [])
     if ts:
         L.append("The same first-arrival speed at other fractions of each probe's first-pulse peak "

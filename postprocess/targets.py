@@ -46,6 +46,9 @@ TARGETS = (
            "m/s", "4270", "4535", None, None,
            "information only: a peak can be a reflection (first arrival is judged)",
            "information"),
+    Target("wave_speed_first_pulse_peak", "P-wave speed from the first pulses' peak "
+           "arrivals A–G (the paper's method on the direct wave)", "m/s", "4270", "4535",
+           None, None, "information only: the first arrival is judged", "information"),
     Target("peak_sigma_rr_A", "peak radial stress at A, 6.8 mm (Fig. 16a)", "MPa",
            "≈130", "—", 130 * 0.8, 130 * 1.2, "130 ± 20 %"),
     Target("peak_sigma_rr_G", "peak radial stress at G, 59.6 mm (Fig. 16a)", "MPa",

@@ -666,6 +666,13 @@ def test_first_arrival_gives_the_p_wave_speed(tmp_path):
     assert "B" in pa["note"] and "reflection" in pa["note"]
     # the reflections' peaks come after the next probe's: no speed through them
     assert "speed_m_s" not in pa and "peak times do not increase" in pa["not_available"]
+    # the same method on the first pulses' peaks, at t0 + d/c_P + T/2 each (to a sample,
+    # DT = 0.01 µs over 11.5 µs between A and G), gives c_P back
+    fp = ws["first_pulse_peak_arrival"]
+    assert fp["speed_m_s"] == pytest.approx(C_P, rel=2e-3) and fp["excluded"] == {}
+    assert sorted(fp["probes"]) == sorted(d)
+    for a in fp["arrivals"]:
+        assert a["t_us"] == pytest.approx((t0 + d[a["name"]] / C_P + T / 2) * 1e6, abs=0.011)
     row = {r["key"]: r for r in m["targets"]}
     assert row["wave_speed"]["verdict"] == "within"
     assert row["wave_speed"]["value"] == pytest.approx(ws["speed_m_s"])
@@ -825,6 +832,9 @@ def test_arrivals_out_of_order_are_an_error(tmp_path):
     # the peaks are out of order too: the paper's method gives no speed, and says why
     assert rows["wave_speed_peak"]["value"] is None
     assert "peak times do not increase" in ws["peak_arrival"]["not_available"]
+    assert rows["wave_speed_first_pulse_peak"]["value"] is None
+    assert "first-pulse peak times do not increase" in (
+        ws["first_pulse_peak_arrival"]["not_available"])
     assert [e["measure"] for e in m["errors"]] == ["wave speed (first arrivals)"]
     make_report(path, tmp_path / "rep", MPI.COMM_SELF)
     md = (tmp_path / "rep" / "report.md").read_text()
