@@ -194,13 +194,14 @@ def test_record(two_reports, capsys):
 def test_changed_verdict_is_flagged(tmp_path, capsys):
     """A verdict stored in report.json that targets.verdict no longer gives (the bands
     changed since the report) is shown beside the current one."""
+    k = next(i for i, t in enumerate(TARGETS) if i > 0 and t.kind == "range")
     doc = report_json("old", {t.key: inside(t) for t in TARGETS})
-    doc["targets"][2]["verdict"] = "outside"
+    doc["targets"][k]["verdict"] = "outside"
     d = write_report(tmp_path / "old" / "report", doc)
     assert main(["validate", "--out", str(tmp_path / "v" / "validation"), str(d)]) == 0
     md = (tmp_path / "v" / "validation.md").read_text()
-    row = table(md, "## Targets")[2 + 2]
-    assert row[0] == TARGETS[2].label and row[6] == "**within** (report.json: outside)"
+    row = table(md, "## Targets")[2 + k]
+    assert row[0] == TARGETS[k].label and row[6] == "**within** (report.json: outside)"
 
 
 def test_without_lattice_bias_and_notes(two_reports, capsys):
