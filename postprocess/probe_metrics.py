@@ -269,7 +269,10 @@ def _first_pulse_peak_arrival(pts) -> dict:
     each probe's first-pulse peak (:func:`_first_pulse_peak`), the wave the paper's
     peaks belong to ("a series of stress waves with reducing magnitude", §3.3).  A probe
     without a first-pulse peak is left out with its reason; times that do not increase
-    with distance give no speed, as in :func:`_peak_arrival`."""
+    with distance give no speed, as in :func:`_peak_arrival`.  The times are the sampled
+    ones of the first-pulse peak (not refined by a parabola as the whole-run peaks' are).
+    A far probe's first pulse can run into the next compression in a fracturing run
+    (§38 of docs/validation_notes.md): read the R² and the times, not the speed alone."""
     have = [p for p in pts if p.get("t_first_pulse_peak_us") is not None]
     left = {p["name"]: p["first_pulse_peak_MPa"]["not_available"] for p in pts
             if p.get("t_first_pulse_peak_us") is None
