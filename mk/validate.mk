@@ -108,7 +108,8 @@ FAILP_slab_failp_T108 = --set materials.granite.T=108e6
 FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
 # on full rows (a row without its run file here is skipped with a line saying so): the
 # crushed zone by mode (--crushed-only: their frames are microseconds apart) and each
-# crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44)
+# crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44);
+# then the direct wave's peak-arrival speed of every row that stores first-pulse peak times
 FAILP_ROWS = gas_contact seamless
 
 .PHONY: diagnoses
@@ -129,6 +130,8 @@ diagnoses: install
 	    cp runs/diag/$$r/failure_pressure.txt docs/diagnoses/failure_pressure_$$r.txt || exit 1; \
 	    cp runs/diag/$$r/zone_split.txt docs/diagnoses/zone_split_$$r.txt || exit 1; \
 	    else echo "skip $$r: no $$f (its command is above VALIDATE_RUNS)"; fi; done
+	@mkdir -p runs/diag && $(PY) benchmarks/diagnoses/peak_arrival_rows.py docs/validation \
+	    > runs/diag/peak_arrival_rows.txt && cp runs/diag/peak_arrival_rows.txt docs/diagnoses/
 
 # compare_rows(OUT, TITLE, BASE_LABEL=BASE_DIR, ROWS, WHAT): the comparison table of
 # `make sensitivity`, `make model-cases` and `make resolution` — the base row beside every
