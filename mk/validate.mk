@@ -75,6 +75,9 @@
 #   77b4891, whose mpipd/ is 394558f's: one physics throughout; the case at dt 1e-8 s, max_ratio 8, notes §44):
 #   mpirun -n 2 mpipd run blast_paper:seamless --out runs/blast_paper_seamless,
 #   then mpirun -n 2 mpipd run --restart runs/blast_paper_seamless/checkpoint.h5 (twice)
+# blast_paper_case5_rerun (77b4891, whose mpipd/ is 394558f's; case 5 run again for the ring-crack measure of §33,
+#   notes §45): mpirun -n 2 mpipd run blast_paper:case5 --set output.every=200 --set output.checkpoint_every=500
+#   --out runs/blast_paper_case5_rerun
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -85,6 +88,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
+    runs/blast_paper_case5_rerun/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
