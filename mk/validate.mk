@@ -113,8 +113,9 @@ FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
 # on full rows (a row without its run file here is skipped with a line saying so): the
 # crushed zone by mode (--crushed-only: their frames are microseconds apart) and each
 # crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44);
-# then the direct wave's peak-arrival speed of every row that stores first-pulse peak times
-FAILP_ROWS = gas_contact seamless
+# the ring arcs at every frame (§45); then the direct wave's peak-arrival speed of every
+# row that stores first-pulse peak times
+FAILP_ROWS = gas_contact seamless case5_rerun
 
 .PHONY: diagnoses
 diagnoses: install
@@ -131,8 +132,10 @@ diagnoses: install
 	    $(PY) benchmarks/diagnoses/failure_pressure.py $$f --crushed-only \
 	    > runs/diag/$$r/failure_pressure.txt || exit 1; \
 	    $(PY) benchmarks/diagnoses/zone_split.py $$f > runs/diag/$$r/zone_split.txt || exit 1; \
+	    $(PY) benchmarks/diagnoses/ring_history.py $$f > runs/diag/$$r/ring_history.txt || exit 1; \
 	    cp runs/diag/$$r/failure_pressure.txt docs/diagnoses/failure_pressure_$$r.txt || exit 1; \
 	    cp runs/diag/$$r/zone_split.txt docs/diagnoses/zone_split_$$r.txt || exit 1; \
+	    cp runs/diag/$$r/ring_history.txt docs/diagnoses/ring_history_$$r.txt || exit 1; \
 	    else echo "skip $$r: no $$f (its command is above VALIDATE_RUNS)"; fi; done
 	@mkdir -p runs/diag && $(PY) benchmarks/diagnoses/peak_arrival_rows.py docs/validation \
 	    > runs/diag/peak_arrival_rows.txt && cp runs/diag/peak_arrival_rows.txt docs/diagnoses/
