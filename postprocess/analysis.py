@@ -124,6 +124,15 @@ def _ppv_radius(ppv, profile) -> dict:
     return {"not_available": "no probes A-G in the rock and no peak_speed field"}
 
 
+def crack_sections(run, model, requests) -> dict | None:
+    """The crack sections (CRACK_SECTIONS: the end faces and mid-thickness) of the
+    run's rock with ``requests`` = [(field, frame)], as
+    :func:`postprocess.sections.gather_sections` gives them (rank 0; None elsewhere)."""
+    zoned = secs.named_levels(secs.zone_levels(run, model), model)
+    return secs.gather_sections(run, model, {n: z for n, z in zoned.items()
+                                             if n in CRACK_SECTIONS}, requests)
+
+
 def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     times = run.time
     last = run.frames - 1

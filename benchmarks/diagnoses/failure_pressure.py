@@ -32,16 +32,13 @@ from mpi4py import MPI
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from mpipd.kernels.layout import MODE_NAMES  # noqa: E402
 from postprocess import cracks  # noqa: E402
-from postprocess import sections as secs  # noqa: E402
-from postprocess.analysis import CRACK_SECTIONS  # noqa: E402
+from postprocess.analysis import crack_sections  # noqa: E402
 from postprocess.model import load_model  # noqa: E402
 from postprocess.reader import Run  # noqa: E402
 
 
 def crushed_by_mode(run, model, last):
-    named = secs.named_levels(secs.zone_levels(run, model), model)
-    want = {n: z for n, z in named.items() if n in CRACK_SECTIONS}
-    data = secs.gather_sections(run, model, want, [("damage", last), ("failure_mode", last)])
+    data = crack_sections(run, model, [("damage", last), ("failure_mode", last)])
     if not all(("failure_mode", last) in sec for sec in data.values()):
         print("no failure_mode field: no crushed zone by mode")
         return

@@ -17,8 +17,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from postprocess import crack_orientation, cracks  # noqa: E402
-from postprocess import sections as secs  # noqa: E402
-from postprocess.analysis import CRACK_SECTIONS  # noqa: E402
+from postprocess.analysis import crack_sections  # noqa: E402
 from postprocess.model import load_model  # noqa: E402
 from postprocess.reader import Run  # noqa: E402
 
@@ -33,10 +32,7 @@ def main():
     run = Run(args.run_file, MPI.COMM_WORLD)
     model = load_model(run)
     frames = [k for k in range(run.frames) if run.time[k] * 1e6 >= args.from_us - 1e-9]
-    named = secs.named_levels(secs.zone_levels(run, model), model)
-    data = secs.gather_sections(run, model, {n: z for n, z in named.items()
-                                             if n in CRACK_SECTIONS},
-                                [("damage", k) for k in frames])
+    data = crack_sections(run, model, [("damage", k) for k in frames])
     print(f"# {args.run_file}: {model.scene_name} at {run.attr('git_commit', 'unknown')}; "
           f"ring arcs (chains of circumferential failed points >= "
           f"{crack_orientation.RING_MIN_HORIZONS:g} horizons long) and failed rings per frame\n")

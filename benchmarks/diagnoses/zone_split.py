@@ -24,8 +24,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from postprocess import cracks  # noqa: E402
-from postprocess import sections as secs  # noqa: E402
-from postprocess.analysis import CRACK_SECTIONS  # noqa: E402
+from postprocess.analysis import crack_sections  # noqa: E402
 from postprocess.model import load_model  # noqa: E402
 from postprocess.reader import Run  # noqa: E402
 
@@ -52,9 +51,7 @@ def main():
     run = Run(args.run_file, MPI.COMM_WORLD)
     model = load_model(run)
     last = run.frames - 1
-    named = secs.named_levels(secs.zone_levels(run, model), model)
-    data = secs.gather_sections(run, model, {n: z for n, z in named.items()
-                                             if n in CRACK_SECTIONS}, [("damage", last)])
+    data = crack_sections(run, model, [("damage", last)])
     rs = args.split_mm * 1e-3
     print(f"# {args.run_file}: {model.scene_name} at {run.attr('git_commit', 'unknown')}; "
           f"t = {run.time[last] * 1e6:.2f} us; zones split at r = {args.split_mm:g} mm\n")
