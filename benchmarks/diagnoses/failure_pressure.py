@@ -27,14 +27,14 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from diag_run import open_run  # noqa: E402
+
 from mpipd.kernels.layout import MODE_NAMES  # noqa: E402
 from postprocess import cracks  # noqa: E402
 from postprocess.analysis import crack_sections  # noqa: E402
-from postprocess.model import load_model  # noqa: E402
-from postprocess.reader import Run  # noqa: E402
 
 
 def crushed_by_mode(run, model, last):
@@ -92,10 +92,7 @@ def main():
     ap.add_argument("--rings", type=int, default=14)
     ap.add_argument("--crushed-only", action="store_true")
     args = ap.parse_args()
-    if MPI.COMM_WORLD.size != 1:
-        sys.exit("failure_pressure.py runs on 1 rank")
-    run = Run(args.run_file, MPI.COMM_WORLD)
-    model = load_model(run)
+    run, model = open_run(args.run_file, "failure_pressure.py")
     commit = run.attr("git_commit", "unknown")
     print(f"# {args.run_file}: {model.scene_name} at {commit}, overrides "
           f"{' '.join(model.overrides) or 'none'}\n")

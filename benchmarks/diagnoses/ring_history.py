@@ -13,13 +13,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from mpi4py import MPI
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from diag_run import open_run  # noqa: E402
+
 from postprocess import crack_orientation, cracks  # noqa: E402
 from postprocess.analysis import crack_sections  # noqa: E402
-from postprocess.model import load_model  # noqa: E402
-from postprocess.reader import Run  # noqa: E402
 
 
 def main():
@@ -27,10 +26,7 @@ def main():
     ap.add_argument("run_file")
     ap.add_argument("--from-us", type=float, default=8.0)
     args = ap.parse_args()
-    if MPI.COMM_WORLD.size != 1:
-        sys.exit("ring_history.py runs on 1 rank")
-    run = Run(args.run_file, MPI.COMM_WORLD)
-    model = load_model(run)
+    run, model = open_run(args.run_file, "ring_history.py")
     frames = [k for k in range(run.frames) if run.time[k] * 1e6 >= args.from_us - 1e-9]
     data = crack_sections(run, model, [("damage", k) for k in frames])
     print(f"# {args.run_file}: {model.scene_name} at {run.attr('git_commit', 'unknown')}; "

@@ -20,13 +20,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from diag_run import open_run  # noqa: E402
+
 from postprocess import cracks  # noqa: E402
 from postprocess.analysis import crack_sections  # noqa: E402
-from postprocess.model import load_model  # noqa: E402
-from postprocess.reader import Run  # noqa: E402
 
 
 def split_density(x, y, failed, center, dx, r_wall, r_out, r_split):
@@ -46,10 +46,7 @@ def main():
     ap.add_argument("run_file")
     ap.add_argument("--split-mm", type=float, default=10.0)
     args = ap.parse_args()
-    if MPI.COMM_WORLD.size != 1:
-        sys.exit("zone_split.py runs on 1 rank")
-    run = Run(args.run_file, MPI.COMM_WORLD)
-    model = load_model(run)
+    run, model = open_run(args.run_file, "zone_split.py")
     last = run.frames - 1
     data = crack_sections(run, model, [("damage", last)])
     rs = args.split_mm * 1e-3

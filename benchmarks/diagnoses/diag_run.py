@@ -1,0 +1,22 @@
+"""What the serial diagnosis scripts share: a run file opened on one rank, with its model.
+
+    run, model = open_run(path, "zone_split.py")
+
+exits with one line naming the script when started on more than one rank.
+"""
+import sys
+from pathlib import Path
+
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from postprocess.model import load_model  # noqa: E402
+from postprocess.reader import Run  # noqa: E402
+
+
+def open_run(path, script):
+    """(Run, Model) of the run file at ``path``, read serially by ``script``."""
+    if MPI.COMM_WORLD.size != 1:
+        sys.exit(f"{script} runs on 1 rank")
+    run = Run(path, MPI.COMM_WORLD)
+    return run, load_model(run)
