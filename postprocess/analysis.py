@@ -13,7 +13,8 @@ sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
 zone, and the median for the count of major radial cracks; the crack orientation
 (:mod:`postprocess.crack_orientation`: radial, oblique, circumferential, and the
-ring arcs) on the same sections.  The lattice bias
+ring arcs) on the same sections, and the ring arcs again at every saved frame (a ring that
+forms and is overrun shows only there).  The lattice bias
 (:mod:`postprocess.lattice_bias`: 4- and 8-fold Fourier amplitudes of the failed
 points' angles in the zone-2 ring) is measured on every gathered section at the
 last frame.
@@ -55,7 +56,42 @@ def profile_frames(times, n=4) -> list[int]:
     return sorted({int(round(v)) for v in np.linspace((len(t) - 1) / n, len(t) - 1, n)})
 
 
-def _fracture(data_sections, model, last) -> dict:
+def ring_history(sections, model, frames, times) -> dict:
+    """Ring arcs frame by frame: :func:`postprocess.crack_orientation.measure` on the
+    crack sections (CRACK_SECTIONS) at each of ``frames``, as the report applies it at
+    the last frame.  A ring that forms and is later overrun by radial damage (Table 3's
+    case 5, docs/validation_notes.md §45) shows here and not at the last frame.
+
+    Per section and frame: the ring arcs, their total length (mm) and radii (mm), the
+    failed rings' radii (mm).  Per frame: the mean total length over the sections (the
+    last frame's headline basis); ``largest``: the largest of those means, with its
+    frame and time (the first such frame on a tie)."""
+    per = {}
+    for name in CRACK_SECTIONS:
+        if name not in sections:
+            continue
+        sec, rows = sections[name], []
+        for k in frames:
+            failed, _ = cracks.failed_points(sec, k)
+            o = crack_orientation.measure(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                          model.r_wall, model.r_out, horizon=sec["link"])
+            rows.append({"ring_arcs": o["ring_arcs"],
+                         "ring_arc_length_mm": o["ring_arc_length_mm"],
+                         "radii_mm": [a["r_mm"] for a in o["rings"]],
+                         "failed_rings_mm": [r["r_mm"] for r in o["failed_rings"]]})
+        per[name] = rows
+    if not per or not len(frames):
+        return {"not_available": "no crack section or no frame after t = 0"}
+    mean = [float(np.mean([per[n][i]["ring_arc_length_mm"] for n in per]))
+            for i in range(len(frames))]
+    i = int(np.argmax(mean))
+    t_us = [float(times[k]) * 1e6 for k in frames]
+    return {"frames": [int(k) for k in frames], "t_us": t_us, "sections": per,
+            "mean_length_mm": mean,
+            "largest": {"length_mm": mean[i], "frame": int(frames[i]), "t_us": t_us[i]}}
+
+
+def _fracture(data_sections, model, last, history=None, times=None) -> dict:
     out = {}
     crit = None
     for name, z in data_sections["levels"].items():
@@ -72,6 +108,8 @@ def _fracture(data_sections, model, last) -> dict:
                      "crushed_zone": cracks.crushed_zone(*args, mode=sec.get(("failure_mode", last))),
                      "orientation": crack_orientation.measure(*args, horizon=sec["link"])}
     names = [n for n in CRACK_SECTIONS if n in out]
+    hist = (ring_history(data_sections["sections"], model, history, times)
+            if history is not None else {"not_available": "no frames given"})
     dens = [[out[n]["zones"][k]["density_mm_per_mm2"] for n in names] for k in range(3)]
     return {"criterion": crit, "sections": out,
             "mean_density_mm_per_mm2": [float(np.mean(d)) for d in dens],
@@ -86,7 +124,8 @@ def _fracture(data_sections, model, last) -> dict:
                  for n in names])) for k in range(3)],
             "ring_arc_length_mm": float(np.mean([out[n]["orientation"]["ring_arc_length_mm"]
                                                  for n in names])),
-            "ring_arcs": float(np.median([out[n]["orientation"]["ring_arcs"] for n in names]))}
+            "ring_arcs": float(np.median([out[n]["orientation"]["ring_arcs"] for n in names])),
+            "ring_history": hist}
 
 
 def _lattice_bias(data_sections, model, last) -> dict:
@@ -141,7 +180,9 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
         frames.append(last)
     zoned = secs.named_levels(secs.zone_levels(run, model), model)
     named = {k: secs.section_z(v, model) for k, v in zoned.items()}
-    reqs = [("damage", k) for k in frames] + [("failure_mode", last)]
+    history = [k for k in range(run.frames) if times[k] > 0]     # ring arcs at every frame
+    reqs = ([("damage", k) for k in sorted(set(frames) | set(history))]
+            + [("failure_mode", last)])
     gathered = secs.gather_sections(run, model, zoned, reqs)
     sec_data = {"levels": named, "sections": gathered}
     prof_frames = profile_frames(times)
@@ -170,7 +211,8 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     metrics["time_us"] = [t * 1e6 for t in vol["time_s"]]
     metrics["energy_ledger"] = ledger.read(run)
     metrics["global_energy_J"] = metrics["energy_ledger"].get("series_J", {})
-    fr = _fracture(sec_data, model, last) if run.root else None
+    fr = (_fracture(sec_data, model, last, history if run.has_field("damage") else None,
+                    times) if run.root else None)
     metrics["fracture"] = run.comm.bcast(fr, root=0)
     lb = _lattice_bias(sec_data, model, last) if run.root else None
     metrics["lattice_bias"] = run.comm.bcast(lb, root=0)
@@ -229,6 +271,7 @@ def target_values(m: dict) -> dict:
         "major_radial_cracks": _get(fr, "major_radial_cracks"),
         "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
         "ring_arc_length": _get(fr, "ring_arc_length_mm"),
+        "ring_arc_length_largest": _get(fr, "ring_history", "largest", "length_mm"),
         "ppv_radius_2p5": _get(m["ppv_radius"], "value_mm"),
         "peak_gas_pressure": _get(m["gas_pressure"], "peak_MPa"),
         "peak_wall_pressure": _get(m["wall_radial_stress"], "peak_MPa"),
@@ -257,6 +300,9 @@ def _bases(m: dict) -> dict:
            "major_radial_cracks": f"median of {ns} sections",
            "crushed_zone": f"mean of {ns} sections",
            "ring_arc_length": f"mean of {ns} sections",
+           "ring_arc_length_largest": (
+               f"mean of {ns} sections, largest at {fr['ring_history']['largest']['t_us']:.3g} µs"
+               if "largest" in fr.get("ring_history", {}) else ""),
            "ppv_radius_2p5": m["ppv_radius"].get("source", ""),
            "peak_gas_pressure": m["gas_pressure"].get("basis", ""),
            "peak_wall_pressure": m["wall_radial_stress"].get("basis", "")}

@@ -184,7 +184,24 @@ def _orientation(fr) -> list[str]:
         radii = ", ".join(f"{a['r_mm']:.3g}" for a in o["rings"]) or "—"
         L.append(f"| {name} | {o['ring_arcs']} | {o['ring_arc_length_mm']:.4g} | {radii} | "
                  f"{rings_text(s)} |")
-    return L + [""]
+    return L + [""] + _ring_history(fr.get("ring_history", {"not_available": "not computed"}))
+
+
+def _ring_history(h) -> list[str]:
+    L = ["Ring arcs at every saved frame (the same measure; a ring that forms and is overrun "
+         "by radial damage shows only here): ring arcs / total length (mm) per section.", ""]
+    if _na(h):
+        return L + [f"Not available: {h['not_available']}", ""]
+    names = list(h["sections"])
+    L += ["| t (µs) | " + " | ".join(names) + " | mean length (mm) |",
+          "|---|" + "---|" * (len(names) + 1)]
+    for i, t in enumerate(h["t_us"]):
+        cells = [f"{h['sections'][n][i]['ring_arcs']} / "
+                 f"{h['sections'][n][i]['ring_arc_length_mm']:.3g}" for n in names]
+        L.append(f"| {t:.3g} | " + " | ".join(cells) + f" | {h['mean_length_mm'][i]:.3g} |")
+    g = h["largest"]
+    return L + ["", f"Largest mean length: {g['length_mm']:.3g} mm at {g['t_us']:.3g} µs "
+                f"(frame {g['frame']}).", ""]
 
 
 def _lattice_bias(lb) -> list[str]:

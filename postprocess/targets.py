@@ -75,6 +75,10 @@ TARGETS = (
            "total length on a section (§3.2, §3.5)", "mm",
            "minor circumferential cracks; more ring cracks in case 5", "spalling (§3.2)",
            None, None, "information only: the paper gives no number", "information"),
+    Target("ring_arc_length_largest", "ring cracks: the largest over the saved frames of "
+           "the total arc length on a section (the same measure at every frame)", "mm",
+           "minor circumferential cracks; more ring cracks in case 5", "spalling (§3.2)",
+           None, None, "information only: the paper gives no number", "information"),
     Target("ppv_radius_2p5", "distance within which PPV > 2.5 m/s (Fig. 18)", "mm",
            "≈20 (text: '2500 m/s', read as mm/s)", "—", 15.0, 25.0, "20 ± 25 %"),
     Target("peak_gas_pressure", "peak explosive pressure, every step (Fig. 7)", "MPa",

@@ -246,3 +246,36 @@ def test_radial_cracks_an_arc_and_random_failure_make_no_failed_ring(what):
     else:
         failed = np.random.default_rng(3).random(len(x)) < 0.3
     assert _rings(x, y, failed) == []
+
+
+def test_ring_history_finds_a_ring_that_radial_damage_later_overruns():
+    """analysis.ring_history: an arc on one section at frame 2, overrun by radial rays
+    every 4 deg at frame 3.  The last frame (the report's headline) has no ring arc;
+    the history has it at frame 2, R x the angle long, and its largest mean over the
+    three sections is that length / 3 at frame 2's time."""
+    from types import SimpleNamespace
+
+    from postprocess import analysis
+    x, y = _section()
+    rays = _rays(x, y, [10, 70, 130, 190, 250, 310])
+    arc = _ring(x, y, 40e-3, np.radians(20), np.radians(60))
+    over = _rays(x, y, np.arange(14, 68, 4.0))
+    damage = {1: rays, 2: rays | arc, 3: rays | arc | over}
+    sections = {}
+    for i, name in enumerate(analysis.CRACK_SECTIONS):
+        sec = {"x": x, "y": y, "h": np.full(len(x), DX), "link": np.full(len(x), HORIZON)}
+        for k, f in damage.items():
+            sec[("damage", k)] = np.where(f if i == 1 else rays, 1.0, 0.0)
+        sections[name] = sec
+    model = SimpleNamespace(center=(0.0, 0.0), r_wall=R_WALL, r_out=R_OUT)
+    h = analysis.ring_history(sections, model, [1, 2, 3], [0.0, 10e-6, 20e-6, 30e-6])
+    arcs = {n: [row["ring_arcs"] for row in rows] for n, rows in h["sections"].items()}
+    with_arc = analysis.CRACK_SECTIONS[1]
+    assert arcs[with_arc] == [0, 1, 0]
+    assert all(a == [0, 0, 0] for n, a in arcs.items() if n != with_arc)
+    length = h["sections"][with_arc][1]["ring_arc_length_mm"]
+    assert length == pytest.approx(40.0 * np.radians(40), rel=0.08)
+    assert h["sections"][with_arc][1]["radii_mm"] == [pytest.approx(40.0, abs=0.5)]
+    assert h["mean_length_mm"] == pytest.approx([0.0, length / 3, 0.0])
+    assert h["largest"] == {"length_mm": pytest.approx(length / 3), "frame": 2,
+                            "t_us": pytest.approx(20.0)}

@@ -1025,8 +1025,8 @@ def test_report_on_blast_demo_under_mpirun(demo_run, tmp_path):
     for name in doc["figures"].values():
         assert (tmp_path / "rep2" / name).stat().st_size > 10_000
     md = (tmp_path / "rep2" / "report.md").read_text()
-    # 17 rows: the peak-arrival wave speed is shown beside the judged first-arrival one,
-    # and the ring arcs' length is information
+    # every row of TARGETS, the information rows (peak-arrival speeds, first pulses,
+    # ring arcs at the last frame and their largest over the frames) among them
     assert "| quantity | this run |" in md and len(doc["targets"]) == len(TARGETS)
     # the crack orientation on each crack section, its classes adding up to the failed
     for s in doc["fracture"]["sections"].values():
@@ -1035,6 +1035,16 @@ def test_report_on_blast_demo_under_mpirun(demo_run, tmp_path):
             assert sum(zo[c]["points"] for c in ("radial", "oblique", "circumferential",
                                                  "unresolved", "isolated")) == z["failed_points"]
     assert "## Crack orientation" in md
+    # the ring arcs at every frame after t = 0; the last one is the headline's measure
+    h = doc["fracture"]["ring_history"]
+    assert h["frames"] == list(range(1, doc["frames"]))
+    for name, s in doc["fracture"]["sections"].items():
+        assert h["sections"][name][-1]["ring_arcs"] == s["orientation"]["ring_arcs"]
+        assert h["sections"][name][-1]["ring_arc_length_mm"] == pytest.approx(
+            s["orientation"]["ring_arc_length_mm"])
+    assert h["mean_length_mm"][-1] == pytest.approx(doc["fracture"]["ring_arc_length_mm"])
+    assert h["largest"]["length_mm"] == pytest.approx(max(h["mean_length_mm"]))
+    assert "Ring arcs at every saved frame" in md
     assert all(r["verdict"].split(":")[0] in ("within", "outside", "not available",
                                               "information", "error")
                for r in doc["targets"])
