@@ -193,6 +193,8 @@ def _ring_history(h) -> list[str]:
     if _na(h):
         return L + [f"Not available: {h['not_available']}", ""]
     names = list(h["sections"])
+    L[0] += (" Arcs within each section's crushed zone at the last frame are left out (r ≤ "
+             + ", ".join(f"{r:.3g}" for r in h["r_min_mm"].values()) + " mm).")
     L += ["| t (µs) | " + " | ".join(names) + " | mean length (mm) |",
           "|---|" + "---|" * (len(names) + 1)]
     for i, t in enumerate(h["t_us"]):

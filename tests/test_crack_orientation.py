@@ -250,7 +250,8 @@ def test_radial_cracks_an_arc_and_random_failure_make_no_failed_ring(what):
 
 def test_ring_history_finds_a_ring_that_radial_damage_later_overruns():
     """analysis.ring_history: an arc on one section at frame 2, overrun by radial rays
-    every 4 deg at frame 3.  The last frame (the report's headline) has no ring arc;
+    every 4 deg at frame 3; a ring at 5 mm at frame 1, inside the crushed radius given
+    (6 mm), is left out.  The last frame (the report's headline) has no ring arc;
     the history has it at frame 2, R x the angle long, and its largest mean over the
     three sections is that length / 3 at frame 2's time."""
     from types import SimpleNamespace
@@ -260,7 +261,10 @@ def test_ring_history_finds_a_ring_that_radial_damage_later_overruns():
     rays = _rays(x, y, [10, 70, 130, 190, 250, 310])
     arc = _ring(x, y, 40e-3, np.radians(20), np.radians(60))
     over = _rays(x, y, np.arange(14, 68, 4.0))
-    damage = {1: rays, 2: rays | arc, 3: rays | arc | over}
+    wall = _ring(x, y, 5e-3)                 # inside the crushed radius given, 6 mm
+    inner = co.measure(x, y, rays | wall, (0.0, 0.0), DX, R_WALL, R_OUT, HORIZON)["rings"]
+    assert inner and all(a["r_mm"] == pytest.approx(5.0, abs=0.5) for a in inner)
+    damage = {1: rays | wall, 2: rays | arc, 3: rays | arc | over}
     sections = {}
     for i, name in enumerate(analysis.CRACK_SECTIONS):
         sec = {"x": x, "y": y, "h": np.full(len(x), DX), "link": np.full(len(x), HORIZON)}
@@ -268,7 +272,8 @@ def test_ring_history_finds_a_ring_that_radial_damage_later_overruns():
             sec[("damage", k)] = np.where(f if i == 1 else rays, 1.0, 0.0)
         sections[name] = sec
     model = SimpleNamespace(center=(0.0, 0.0), r_wall=R_WALL, r_out=R_OUT)
-    h = analysis.ring_history(sections, model, [1, 2, 3], [0.0, 10e-6, 20e-6, 30e-6])
+    h = analysis.ring_history(sections, model, [1, 2, 3], [0.0, 10e-6, 20e-6, 30e-6],
+                              {n: 6.0 for n in analysis.CRACK_SECTIONS})
     arcs = {n: [row["ring_arcs"] for row in rows] for n, rows in h["sections"].items()}
     with_arc = analysis.CRACK_SECTIONS[1]
     assert arcs[with_arc] == [0, 1, 0]
