@@ -18,7 +18,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diag_run import open_run  # noqa: E402
 
-from postprocess import crack_orientation  # noqa: E402
+from postprocess import crack_orientation, cracks  # noqa: E402
 from postprocess.analysis import crack_sections, ring_history  # noqa: E402
 
 
@@ -30,10 +30,18 @@ def main():
     run, model = open_run(args.run_file, "ring_history.py")
     frames = [k for k in range(run.frames) if run.time[k] * 1e6 >= args.from_us - 1e-9]
     data = crack_sections(run, model, [("damage", k) for k in frames])
-    h = ring_history(data, model, frames, run.time)
+    last = run.frames - 1
+    crushed = {}
+    for name, sec in data.items():          # the report's rule: arcs in the crushed zone left out
+        failed, _ = cracks.failed_points(sec, last)
+        crushed[name] = cracks.crushed_zone(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                            model.r_wall, model.r_out)["r_c_mm"]
+    h = ring_history(data, model, frames, run.time, crushed)
     print(f"# {args.run_file}: {model.scene_name} at {run.attr('git_commit', 'unknown')}; "
           f"ring arcs (chains of circumferential failed points >= "
-          f"{crack_orientation.RING_MIN_HORIZONS:g} horizons long) and failed rings per frame\n")
+          f"{crack_orientation.RING_MIN_HORIZONS:g} horizons long, beyond each section's "
+          f"crushed zone at the last frame: r > "
+          + ", ".join(f"{r:.1f}" for r in crushed.values()) + " mm) and failed rings per frame\n")
     print("t (us)  section  ring arcs  total length (mm)  arc radii (mm)  failed rings r (mm)")
     for i, t in enumerate(h["t_us"]):
         for name, rows in h["sections"].items():
