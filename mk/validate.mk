@@ -78,6 +78,9 @@
 # blast_paper_case5_rerun (77b4891, whose mpipd/ is 394558f's; case 5 run again for the ring-crack measure of §33,
 #   notes §45): mpirun -n 2 mpipd run blast_paper:case5 --set output.every=200 --set output.checkpoint_every=500
 #   --out runs/blast_paper_case5_rerun
+# blast_paper_rerun2 (27a8378, whose mpipd/ is 394558f's: the base scene at the physics of seamless and case5_rerun,
+#   for the ring arcs at every frame beside case 5's, notes §46): mpirun -n 2 mpipd run blast_paper
+#   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_rerun2
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -88,7 +91,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
-    runs/blast_paper_case5_rerun/run.h5 \
+    runs/blast_paper_case5_rerun/run.h5 runs/blast_paper_rerun2/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
@@ -115,7 +118,7 @@ FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
 # crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44);
 # the ring arcs at every frame (§45); then the direct wave's peak-arrival speed of every
 # row that stores first-pulse peak times
-FAILP_ROWS = gas_contact seamless case5_rerun
+FAILP_ROWS = gas_contact seamless case5_rerun rerun2
 
 .PHONY: diagnoses
 diagnoses: install
@@ -160,7 +163,7 @@ endef
 # ranks; the commands are above), its report and `make validate` with it in VALIDATE_RUNS.
 SENS_BASE ?= docs/validation/blast_paper_index
 SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6])) \
-    $(wildcard docs/validation/blast_paper_case5_rerun)
+    $(wildcard docs/validation/blast_paper_case5_rerun) $(wildcard docs/validation/blast_paper_rerun2)
 SENS_OUT ?= docs/sensitivity_blast_paper.md
 .PHONY: sensitivity
 sensitivity: install
