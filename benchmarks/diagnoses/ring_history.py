@@ -10,24 +10,19 @@ of ring arcs, their total length and radii, and the failed rings.
 
     mpirun -n 1 python benchmarks/diagnoses/ring_history.py RUN.h5 [--from-us 8]
 """
-import argparse
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from diag_run import open_run  # noqa: E402
+from diag_run import open_with_option  # noqa: E402
 
 from postprocess import crack_orientation, cracks  # noqa: E402
 from postprocess.analysis import crack_sections, ring_history  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("run_file")
-    ap.add_argument("--from-us", type=float, default=8.0)
-    args = ap.parse_args()
-    run, model = open_run(args.run_file, "ring_history.py")
+    args, run, model = open_with_option("ring_history.py", "--from-us", 8.0)
     frames = [k for k in range(run.frames) if run.time[k] * 1e6 >= args.from_us - 1e-9]
     data = crack_sections(run, model, [("damage", k) for k in frames])
     last = run.frames - 1

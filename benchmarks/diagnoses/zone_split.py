@@ -15,7 +15,6 @@ density in report.json.
 
     mpirun -n 1 python benchmarks/diagnoses/zone_split.py RUN.h5 [--split-mm 10]
 """
-import argparse
 import sys
 from pathlib import Path
 
@@ -23,7 +22,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from diag_run import open_run  # noqa: E402
+from diag_run import open_with_option  # noqa: E402
 
 from postprocess import cracks  # noqa: E402
 from postprocess.analysis import crack_sections  # noqa: E402
@@ -42,11 +41,7 @@ def split_density(x, y, failed, center, dx, r_wall, r_out, r_split):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("run_file")
-    ap.add_argument("--split-mm", type=float, default=10.0)
-    args = ap.parse_args()
-    run, model = open_run(args.run_file, "zone_split.py")
+    args, run, model = open_with_option("zone_split.py", "--split-mm", 10.0)
     last = run.frames - 1
     data = crack_sections(run, model, [("damage", last)])
     rs = args.split_mm * 1e-3
