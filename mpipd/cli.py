@@ -12,10 +12,11 @@ errors, an existing output file, a decomposition that cannot work) prints one
 line ``mpipd: error: <what>`` on rank 0 and exits with status 2 on every rank,
 before anything is written.  A run writes only its own files (mpipd.output.rundir:
 run ids, the restart and --overwrite rules).  A file of the run that cannot be
-written (disk full, read-only) prints one line and exits with status 4; a
-blow-up exits with 3; a clean stop with a checkpoint (--stop-after, SIGTERM or
-SIGUSR1) with 0.  Any other exception on any rank prints its traceback and
-aborts the whole MPI job, so nothing hangs.
+written (disk full, read-only) prints one line and exits with status 4 (a
+finished run whose end checkpoint fails prints its summary first, and that its
+run file is complete); a blow-up exits with 3; a clean stop with a checkpoint
+(--stop-after, SIGTERM or SIGUSR1) with 0.  Any other exception on any rank
+prints its traceback and aborts the whole MPI job, so nothing hangs.
 """
 from __future__ import annotations
 
@@ -232,6 +233,23 @@ def _on_root(team, fn, *args):
         raise err
 
 
+def _end_checkpoint(checkpointer, team, out) -> str | None:
+    """Write a finished run's last checkpoint (collective).  The run file is already
+    closed and whole, so a file system that refuses the checkpoint (disk full,
+    read-only) does not end the run here: the reason comes back as one line for the
+    end of the summary (exit 4); None if written.  The ranks agree on it."""
+    from .output import rundir
+    err = None
+    try:
+        checkpointer.at_end()
+    except Exception as e:
+        cause = rundir.io_cause(e)
+        if cause is None:
+            raise
+        err = rundir.describe_io(cause, out)
+    return next((e for e in team.gather(err) if e), None)
+
+
 def _over_dt(sim, team, scene, failed: bool = False) -> str | None:
     """The multi-rate line on points whose stable step fell below dt in this
     invocation (collective; None if none did, or single-rate; ``failed``: split at
@@ -300,8 +318,8 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             + (f"; {over}" if over else ""), error=True)
         return EXIT_UNSTABLE
     writer.close(segment())
-    if sim.step_count == n_steps:
-        checkpointer.at_end()
+    end_error = (_end_checkpoint(checkpointer, team, out) if sim.step_count == n_steps
+                 else None)
     if sim.step_count < n_steps:
         # what this invocation saw of the stable step: the next one counts afresh
         n_switched = team.sum(sim.corr.floor_switches)
@@ -364,6 +382,14 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "
                 f"{vr:.2f} m/s, peak pressure {pmax / 1e6:.1f} MPa")
     log(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}")
+    if end_error:
+        kept = (f"{checkpointer.path.name} is still step {checkpointer.written_step}'s"
+                if checkpointer.written_step is not None
+                else f"{checkpointer.path.name} is an earlier invocation's"
+                if checkpointer.path.exists() else "no checkpoint")
+        log(f"mpipd: error: {end_error}: the end checkpoint was not written ({kept}); "
+            f"the run file {h5} is complete to step {n_steps}", error=True)
+        return EXIT_IO
     return 0
 
 

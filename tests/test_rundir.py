@@ -227,6 +227,24 @@ def test_full_disk_is_one_line_and_leaves_no_tmp(tmpfs):
     assert (out / "run.h5").exists() and not list(out.glob("*.tmp"))
 
 
+def test_finished_run_whose_end_checkpoint_fails_says_its_run_file_is_complete(tmpfs):
+    """Checkpoints asked for but none due before the end: the run file fits, the
+    end checkpoint does not.  Exit 4 with one error line that says so and that the
+    run file is complete to the last step (60); the summary still printed; the run
+    file holds every frame to t_end; no checkpoint and no .tmp left."""
+    fs = tmpfs("size=3m")
+    out = fs / "run"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL,
+                   "--set", "output.checkpoint_every=1000"], ranks=2, timeout=120)
+    one_error(res, f"cannot write in {out}", "MB free", "end checkpoint was not written",
+              "(no checkpoint)", f"{out / 'run.h5'} is complete to step 60", code=4)
+    assert "energy ledger" in res.stdout, res.stdout
+    with h5py.File(out / "run.h5", "r") as f:
+        assert int(f.attrs["frames_written"]) == f["time"].shape[0] == 4
+        assert f["time"][-1] == pytest.approx(1.2e-5)
+    assert not list(out.glob("*.tmp")) and not (out / "checkpoint.h5").exists()
+
+
 # ----------------------------------------------------------------- signals
 
 def _start(out, extra=()):

@@ -202,6 +202,7 @@ class Checkpointer:
         self._flag = None
         self.signalled = False
         self.written = None
+        self.written_step = None     # the step of the last checkpoint this invocation wrote
 
     def install_signals(self, flag: "SignalFlag | None" = None):
         """Stop at the next poll once SIGTERM/SIGUSR1 arrived — from now on, or,
@@ -225,8 +226,7 @@ class Checkpointer:
         """The last step's checkpoint, when checkpoints were asked for: a finished
         run can then be extended (``--restart ... --set time.t_end=...``)."""
         if self.every:
-            self.written = write(self.sim, self.path, self.scene_text, self.overrides,
-                                 self.run_id)
+            self._write()
 
     def after_step(self) -> bool:
         """Checkpoint if due; True if the run should stop now."""
@@ -235,9 +235,12 @@ class Checkpointer:
         if not stop and step % self.poll == 0:
             stop = bool(self.sim.team.max(int(self.signalled)))
         if stop or (self.every and step % self.every == 0):
-            self.written = write(self.sim, self.path, self.scene_text, self.overrides,
-                                 self.run_id)
+            self._write()
         return stop
+
+    def _write(self):
+        self.written = write(self.sim, self.path, self.scene_text, self.overrides, self.run_id)
+        self.written_step = self.sim.step_count
 
 
 def restore(sim, path) -> None:
