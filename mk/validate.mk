@@ -81,6 +81,10 @@
 # blast_paper_rerun2 (27a8378, whose mpipd/ is 394558f's: the base scene at the physics of seamless and case5_rerun,
 #   for the ring arcs at every frame beside case 5's, notes §46): mpirun -n 2 mpipd run blast_paper
 #   --set output.every=200 --set output.checkpoint_every=500 --out runs/blast_paper_rerun2
+# blast_paper_case6_rerun (d531082, whose mpipd/ differs from 394558f's only in the end-checkpoint message, cli.py, checkpoint.py:
+#   case 6 at the physics of rerun2 and case5_rerun, for its ring arcs at every frame, notes §47):
+#   mpirun -n 2 mpipd run blast_paper:case6 --set output.every=200 --set output.checkpoint_every=500
+#   --out runs/blast_paper_case6_rerun
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -91,7 +95,7 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_slab/run.h5 runs/blast_paper_paper_coupling/run.h5 runs/blast_paper_rockmass/run.h5 \
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
-    runs/blast_paper_case5_rerun/run.h5 runs/blast_paper_rerun2/run.h5 \
+    runs/blast_paper_case5_rerun/run.h5 runs/blast_paper_rerun2/run.h5 runs/blast_paper_case6_rerun/run.h5 \
     runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
@@ -118,7 +122,7 @@ FAILP_CASES = slab_failp slab_failp_linear slab_failp_T108
 # crack-density zone's share inside and beyond r = 10 mm, the seamless band's edge (§44);
 # the ring arcs at every frame (§45); then the direct wave's peak-arrival speed of every
 # row that stores first-pulse peak times
-FAILP_ROWS = gas_contact seamless case5_rerun rerun2
+FAILP_ROWS = gas_contact seamless case5_rerun rerun2 case6_rerun
 
 .PHONY: diagnoses
 diagnoses: install
@@ -158,12 +162,14 @@ endef
 # the record: the base scene (SENS_BASE, the default rule's full run) beside every case
 # row docs/validation/blast_paper_case<k>/ that exists, and the base run again at a later
 # commit (blast_paper_rerun, notes §36: the base's own shift) and case 5 run again at a
-# later commit (blast_paper_case5_rerun, notes §45: its ring cracks), in
+# later commit (blast_paper_case5_rerun, notes §45: its ring cracks), the base again beside
+# it (blast_paper_rerun2, §46) and case 6 again (blast_paper_case6_rerun, §47), in
 # docs/sensitivity_blast_paper.md. A case row is made by its run (about an hour on 2
 # ranks; the commands are above), its report and `make validate` with it in VALIDATE_RUNS.
 SENS_BASE ?= docs/validation/blast_paper_index
 SENS_ROWS ?= $(wildcard docs/validation/blast_paper_rerun) $(sort $(wildcard docs/validation/blast_paper_case[1-6])) \
-    $(wildcard docs/validation/blast_paper_case5_rerun) $(wildcard docs/validation/blast_paper_rerun2)
+    $(wildcard docs/validation/blast_paper_case5_rerun) $(wildcard docs/validation/blast_paper_rerun2) \
+    $(wildcard docs/validation/blast_paper_case6_rerun)
 SENS_OUT ?= docs/sensitivity_blast_paper.md
 .PHONY: sensitivity
 sensitivity: install
