@@ -203,15 +203,15 @@ def _run(args, team, signals=None) -> int:
         return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
                        n_steps, dt_stable, run_id, resume)
     except Exception as e:
-        cause = rundir.io_cause(e)
-        if cause is None:
+        line = rundir.io_line(e, out)
+        if line is None:
             raise
         for tmp in out.glob("*.h5.tmp"):         # a checkpoint that did not finish
             try:
                 tmp.unlink()
             except OSError:
                 pass
-        raise rundir.IOFailure(rundir.describe_io(cause, out)) from None
+        raise rundir.IOFailure(line) from None
 
 
 def _shown(text: str, overrides) -> str:
@@ -243,10 +243,9 @@ def _end_checkpoint(checkpointer, team, out) -> str | None:
     try:
         checkpointer.at_end()
     except Exception as e:
-        cause = rundir.io_cause(e)
-        if cause is None:
+        err = rundir.io_line(e, out)
+        if err is None:
             raise
-        err = rundir.describe_io(cause, out)
     return next((e for e in team.gather(err) if e), None)
 
 

@@ -177,6 +177,13 @@ def describe_io(exc: OSError, out: Path) -> str:
     return f"cannot write in {out}: {reason}"
 
 
+def io_line(exc: BaseException, out: Path) -> str | None:
+    """:func:`describe_io` of the OSError behind ``exc`` (:func:`io_cause`); None
+    if no OSError is behind it (then it is no file-system failure)."""
+    cause = io_cause(exc)
+    return None if cause is None else describe_io(cause, out)
+
+
 class IOFailure(Fatal):
     """Writing a run's own file failed (disk full, read-only, quota): one line, exit 4."""
     exit_code = 4
