@@ -42,7 +42,7 @@ def test_polar_update_tracks_F(hist, tol):
         F_new = hist((k + 1) * dt)[None].copy()
         Fdot = (F_new - F_old) / dt
         rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, np.ones_like(J), np.ones_like(J),
-                       np.zeros(1, np.uint8), 0)
+                       np.zeros(1, np.uint8), 0, np.zeros(1, np.uint8))
         F_old = F_new
         # V stays symmetric to round-off only with the right sign of the correction
         assert np.abs(V[0] - V[0].T).max() < 1e-12

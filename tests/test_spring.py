@@ -223,3 +223,59 @@ def test_a_point_whose_F_turns_singular_takes_its_last_F_as_spring_reference(tea
     assert E0 > 10 * hg > 0
     assert abs(sim.corr.potentials(np.array([c]), sim.u)[0, 1]) <= 1e-12 * E0
     assert sim.ledger.jumps - j0 == pytest.approx(hg, rel=1e-9)
+
+
+# -------------------------------------------------- a point switched to the springs keeps its state
+def _loaded_point_on_springs(team):
+    """A 7^3 block of Table 1's JH2 granite with the tension model (dx 1 mm, at rest),
+    its centre point given by hand a uniaxial-strain state — axial deviator
+    -2/3 s, lateral +1/3 s with s = 230 MPa, pressure 35 MPa (what the rock near the
+    borehole wall carries) — and then cut down to two opposite bonds, so that its
+    shape tensor is singular and it takes the bond springs (SPRING_K)."""
+    from mpipd.kernels.layout import SPRING_K
+    dx = 1e-3
+    d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [7 * dx] * 3}, dx=dx, dt=2e-8)
+    d["materials"] = {"granite": {"model": "jh2", "tension": {"sigma_st": -6.9e6, "c1": 0.33,
+                                                               "rate0": 0.4}}}
+    sim = Simulation(make_scene(d), team)
+    sim.initialize()
+    n = sim.points.n_owned
+    c = int(np.argmin(np.linalg.norm(sim.points.x[:n] - 3.5 * dx, axis=1)))
+    s_eq, p = 230e6, 35e6
+    a = s_eq / 1.5                      # von Mises of diag(-a, a/2, a/2) is 1.5 a
+    sim.corr.sigma[c] = [-a - p, 0.5 * a - p, 0.5 * a - p, 0.0, 0.0, 0.0]
+    g = sim.corr.groups[0]
+    pos = int(np.flatnonzero(g.idx == c)[0])
+    g.state["pressure"][pos] = p
+    fam, x = sim.families, sim.points.x
+    b0, b1 = fam.offsets[c], fam.offsets[c + 1]
+    xi = x[fam.nbr[b0:b1]] - x[c]
+    keep = (np.abs(np.abs(xi[:, 0]) - dx) < 1e-9) & (np.abs(xi[:, 1:]).sum(axis=1) < 1e-9)
+    fam.broken[b0:b1] = ~keep
+    sim.corr.rebuild_shape(np.array([c]), sim.u)
+    assert sim.corr.spring[c] == SPRING_K
+    return sim, c, pos, s_eq, p
+
+
+def test_a_point_switched_to_the_springs_keeps_its_material_state(team):
+    """The springs replace the point's force, not its material (paper §2.1): over
+    steps on the springs its stress, damage and failure mode stay as they were.
+    Computed here: with the placeholder kinematics (J = 1, d = 0) put through JH2,
+    p would fall to 0 and the strength to sigma_HEL A (T/p_HEL)^N = 166 MPa < s,
+    and the yield step's plastic strain (s - sigma_y) / 3G = 8.3e-4 exceeds
+    eps_f = D1 (T/p_HEL)^D2 = 2.6e-4: D = 1 in the first step (the old code's
+    failure of every switched point)."""
+    sim, c, pos, s_eq, p = _loaded_point_on_springs(team)
+    mat = sim.corr.groups[0].material
+    ts = mat.T / mat.p_HEL
+    sy0 = mat.sigma_hel * mat.A * ts ** mat.N
+    assert sy0 < s_eq and (s_eq - sy0) / (3 * mat.shear_modulus) > mat.D1 * ts ** mat.D2
+    before = sim.corr.sigma[c].copy()
+    for _ in range(3):
+        sim.step()
+    g = sim.corr.groups[0]
+    assert sim.mode[c] == 0
+    assert g.state["D"][pos] == 0.0
+    assert g.state["pressure"][pos] == p
+    np.testing.assert_array_equal(sim.corr.sigma[c], before)
+    assert not (sim.mode == 255).any()                      # MODE_HELD never left behind

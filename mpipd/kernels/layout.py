@@ -67,3 +67,8 @@ MODE_LABELS = ("intact", "JH2 plastic (D >= 1)", "JH2 tensile (p < -T)",
                "tension model (Eq. 38)")
 #: the number of modes including INTACT (length of a count vector)
 N_MODES = 4
+#: not a failure mode: the code an intact point on the bond springs carries only
+#: while the materials update and the tension model runs, so that both skip it as
+#: they skip a failed point (mpipd.model.correspondence.Correspondence.hold); never
+#: seen outside those calls, never exchanged or written
+MODE_HELD = 255

@@ -27,7 +27,7 @@ from .linalg import det3, inv3, mat_to_voigt, mul3, mul3_at
 
 
 @numba.njit(cache=True)
-def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac, klass, level):
+def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac, klass, level, held):
     """Advance R and V of every owned point whose step class acts at ``level``
     (kernels.classes) by its step dt_i = 2^k_i dt; write d (Voigt), J = c det F_mid
     (for the stress power and the viscosity, which live at mid-step) and
@@ -43,7 +43,13 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac, klas
     A point of a coarse class (k_i > 0) takes Fdot = (F_{n+1} - F_n) / dt_i,
     the mean rate over its own step (its neighbours of finer classes moved at
     several speeds within it); class 0 keeps Fdot of Eq. 13 from the mid-step
-    velocities, which is the same for a family of one class."""
+    velocities, which is the same for a family of one class.
+
+    ``held[i]`` is set to 1 for a total-Lagrangian point that has no continuum
+    kinematics this step (on the bond springs, SPRING_K, or with a non-positive or
+    non-finite det F_mid): its d = 0 and J = 1 are placeholders, not a state, so the
+    material update and the tension check must leave it alone (Correspondence.hold);
+    0 for every other point of the level."""
     n = F_new.shape[0]
     Fm = np.empty((3, 3))
     Fi = np.empty((3, 3))
@@ -74,7 +80,9 @@ def rotate_stretch(F_old, F_new, Fdot, R, V, dt, spring, d, J, J_end, Jfac, klas
                 d[i, c] = 0.0
             J[i] = 1.0
             J_end[i] = 1.0
+            held[i] = 0 if spring[i] == NOT_TL else 1
             continue
+        held[i] = 0
         c = Jfac[i]
         J[i] = c * inv3(Fm, Fi)
         Je = det3(F_new[i])

@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from ..kernels import energy, integrate, nosb, rotation
-from ..kernels.layout import CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, NOT_TL, SPRING_F, SPRING_K
+from ..kernels.layout import CORRESPONDENCE, FD_WIDTH, FD_WIDTH_VISCOUS, INTACT, MODE_HELD, NOT_TL, SPRING_F, SPRING_K
 from ..kernels.viscosity import viscosity_data
 from ..materials.base import STATE_OUTPUTS
 from ..state import AUX, BOND, LAST, LOCAL, REBUILT
@@ -180,6 +180,9 @@ class Correspondence(Model):
         self.J = np.ones(n)                     # det F at mid-step (stress power, viscosity)
         self.J_end = np.ones(n)                 # c det F at the end of the step (materials)
         self.Jfac = np.ones(n)                  # volume factor c (rebuild_shape)
+        #: 1 where the last rotate found no continuum kinematics (kernels.rotation):
+        #: the point keeps its material state (:meth:`hold`)
+        self.held = np.zeros(n, np.uint8)
         self.toggled = np.zeros(n, np.int64)    # points that switched to/from SPRING_F
         self.W = np.zeros(n)                    # strain energy per reference volume
         self.gamma = np.zeros(n)                # sum_j omega V_j (Eq. 43)
@@ -222,7 +225,7 @@ class Correspondence(Model):
         own, mode = self.name, self.mode
         add = state.add
         for name in ("Kinv", "trK", "Fdot", "J", "toggled", "gamma", "dil", "hg_modulus", "lam",
-                     "floor"):
+                     "floor", "held"):
             add(name, own, getattr(self, name))
         # with step classes a point keeps its last rate and volume between its updates:
         # the tension check (every step) and the ledger read them, so a restart needs them
@@ -392,21 +395,51 @@ class Correspondence(Model):
         cl = self.classes
         rotation.rotate_stretch(self.F_old, self.F, self.Fdot, self.R, self.V, dt,
                                 self.spring, self.d, self.J, self.J_end, self.Jfac,
-                                cl.klass, cl.level)
+                                cl.klass, cl.level, self.held)
+
+    def hold(self, mode: np.ndarray) -> np.ndarray:
+        """Mark the intact points the last rotate held (on the bond springs, or with no
+        valid F this step) MODE_HELD in ``mode`` and return them; :meth:`release` undoes it.
+
+        Such a point's d = 0 and J = 1 are placeholders (kernels.rotation), not its
+        state: put through a material update they would reset JH2's compression to 0
+        (p collapses to the bulking term) and its rate terms to their static values,
+        and the tension model would then fail the point from the switch itself.  The
+        paper's fallback (§2.1) replaces the point's force, not its material: held
+        out of both calls as a failed point is, it keeps its stress, damage and
+        history until it leaves the springs or fails by breakage."""
+        rows = np.flatnonzero(self.held)
+        rows = rows[mode[rows] == INTACT]
+        mode[rows] = MODE_HELD
+        return rows
+
+    @staticmethod
+    def release(mode: np.ndarray, rows: np.ndarray):
+        mode[rows] = INTACT
 
     def update_stress(self, dt: float, mode: np.ndarray):
-        """Materials advance the stress; ``mode`` (failure flags) may be set by them."""
+        """Materials advance the stress; ``mode`` (failure flags) may be set by them.
+        Points on the bond springs keep their material state (:meth:`hold`)."""
         k, level = self.classes.klass, self.classes.level
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W, k, level)
-        for g in self.groups:
-            g.update(self.d, self.J_end, dt, self.sigma, mode, level)
+        rows = self.hold(mode)
+        try:
+            for g in self.groups:
+                g.update(self.d, self.J_end, dt, self.sigma, mode, level)
+        finally:
+            self.release(mode, rows)
         integrate.stress_power(self.sigma, self.d, self.J, 0.5 * dt, self.spring, self.W, k, level)
 
     def check_tension(self, mode: np.ndarray) -> int:
         """Tension failure model (Eqs. 37–38) of the materials that have one, at the
-        points whose state was updated at this step's level."""
+        points whose state was updated at this step's level (points on the bond
+        springs are not checked: :meth:`hold`)."""
         level = self.classes.level
-        return sum(g.check_tension(self.sigma, self.d, mode, level) for g in self.groups)
+        rows = self.hold(mode)
+        try:
+            return sum(g.check_tension(self.sigma, self.d, mode, level) for g in self.groups)
+        finally:
+            self.release(mode, rows)
 
     def force_data(self, u, ledger=None) -> tuple:
         """Force data of the owned points (returned for the halo).  A point that
