@@ -21,9 +21,10 @@ Stable time step.  Two estimates per part, and the scene's dt against the smalle
 
 Both assume the reference moduli, i.e. the wave speed c_p of the material at
 rest.  Scaled by c_p, the scene's dt stays below the critical step for waves up
-to c_max = c_p dt_c / dt; for a JH2 EOS, whose stiffness dp/dmu grows as K3 mu^2,
-the report gives the compression mu where the P-wave speed reaches c_max (beyond
-it the run needs a smaller dt; the solver cannot know the compression in advance).
+to c_max = c_p dt_c / dt; for a JH2 EOS, whose stiffness dp/dmu grows as K3 mu^2
+(and for JH2's linear ``pressure = "incremental"``, whose (1 + mu)^2 dp/dmu =
+(1 + mu) K1 grows slowly), the report gives the compression mu where the P-wave speed reaches c_max (beyond it the run
+needs a smaller dt; the solver cannot know the compression in advance).
 
 Measured against these estimates (tests/test_stability.py): the correspondence
 model's true critical step is larger, 1.7-1.85 x for free elastic granite and J2
@@ -320,15 +321,20 @@ def check_report(scene, ranks: int) -> str:
         mu = wave_speed_limit(mat, c_max)
         if mu is not None:
             c_far = float(mat.p_wave_speed_at(MU_FAR))
-            out.append(f"      EOS stiffening: the P-wave speed sqrt(((1+mu)^2 dp/dmu + 4G/3)/rho) passes "
+            what = ("stiffening of the linear pressure (dp/dmu = K1/(1+mu))"
+                    if getattr(mat, "incremental", False) else "EOS stiffening")
+            out.append(f"      {what}: the P-wave speed sqrt(((1+mu)^2 dp/dmu + 4G/3)/rho) passes "
                        f"{c_max:.1f} m/s at mu = {mu:.4g}; beyond, dt is above the critical step "
                        f"(at mu = {MU_FAR:g}: {c_far:.0f} m/s, dt <= {dt_c * c_p / c_far:.3e} s "
                        f"needed)")
     for name, mat in scene.materials.items():
+        if getattr(mat, "incremental", False):
+            out.append(f"  material {name!r}: pressure \"incremental\" (Eq. 35): p_el += -K1 tr(d) dt, "
+                       f"K1 = {mat.bulk_modulus:.4g} Pa at every mu (K2, K3 not used)")
         region = getattr(mat, "negative_tangent", lambda: None)()
         if region is not None:
-            out.append(f"  material {name!r}: EOS tangent dp/dmu < 0 for mu in "
-                       f"{region[0]:.5f}..{region[1]:.5f} (K2 = {mat.K2:.4g} Pa, "
+            out.append(f"  material {name!r}: EOS (pressure \"eos\", Eq. 25) tangent dp/dmu < 0 "
+                       f"for mu in {region[0]:.5f}..{region[1]:.5f} (K2 = {mat.K2:.4g} Pa, "
                        f"K3 = {mat.K3:.4g} Pa): the wave speed and the viscosity use K1 there")
     out.append(f"  total: {table.n_points} points, {int(bonds.sum())} bonds "
                f"(counted from the cross-sections)")

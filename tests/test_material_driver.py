@@ -7,7 +7,8 @@ correspondence machinery calls it, along strain paths whose small-strain answers
 are computed in the test (isotropic linear elasticity, K = ``bulk_modulus``,
 G = ``shear_modulus``).  A newly registered material is picked up
 automatically; one whose required parameters this driver cannot fill fails
-with a message naming them.
+with a message naming them.  A material with a choice of law (:data:`CHOICES`:
+JH2's ``pressure``, "eos" or "incremental") is driven under each choice.
 """
 import dataclasses
 
@@ -16,21 +17,29 @@ import pytest
 
 from mpipd.input.schema import build
 from mpipd.materials import MATERIALS
+from mpipd.materials.jh2 import PRESSURES
 
 #: values for parameters a material requires (no default): a granite-like solid
 REQUIRED = {"density": 2660.0, "bulk_modulus": 21.9e9, "shear_modulus": 25.7e9}
 
 SOLIDS = [n for n in MATERIALS.names() if MATERIALS.get(n).family == "tl"]
 
+#: a material with a choice of law is driven once per choice (its settings here);
+#: every other solid once, with its defaults
+CHOICES = {"jh2": [{"pressure": p} for p in PRESSURES]}
 
-def make(name):
+CASES = [pytest.param(n, o, id="-".join([n, *map(str, o.values())]))
+         for n in SOLIDS for o in CHOICES.get(n, [{}])]
+
+
+def make(name, options=None):
     cls = MATERIALS.get(name)
     need = [f.name for f in dataclasses.fields(cls)
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
     missing = [k for k in need if k not in REQUIRED]
     if missing:
         pytest.fail(f"material {name!r} requires {missing}: give the driver values for them")
-    return build(cls, {k: REQUIRED[k] for k in need}, f"materials.{name}")
+    return build(cls, {**{k: REQUIRED[k] for k in need}, **(options or {})}, f"materials.{name}")
 
 
 def drive(mat, d_rate, t_total, steps=200, n=1, mode=None):
@@ -65,28 +74,30 @@ def test_every_solid_is_driven():
     updated-Lagrangian gas, tests/test_gas.py)."""
     assert {"elastic", "j2", "jh2"} <= set(SOLIDS)
     assert all(MATERIALS.get(n).family in ("tl", "ul") for n in MATERIALS.names())
+    assert set(CHOICES) <= set(SOLIDS)
+    assert [c.values[1]["pressure"] for c in CASES if c.values[0] == "jh2"] == ["eos", "incremental"]
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_state_arrays_have_one_row_per_point(name):
-    mat = make(name)
+@pytest.mark.parametrize("name,options", CASES)
+def test_state_arrays_have_one_row_per_point(name, options):
+    mat = make(name, options)
     for n in (0, 1, 7):
         for key, arr in mat.new_state(n).items():
             assert arr.shape[0] == n, key
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_no_rate_no_stress(name):
-    sigma, W, _, mode, _ = drive(make(name), np.zeros(6), 1e-6, steps=20)
+@pytest.mark.parametrize("name,options", CASES)
+def test_no_rate_no_stress(name, options):
+    sigma, W, _, mode, _ = drive(make(name, options), np.zeros(6), 1e-6, steps=20)
     assert np.all(sigma == 0.0) and np.all(W == 0.0) and np.all(mode == 0)
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_uniaxial_strain_small(name):
+@pytest.mark.parametrize("name,options", CASES)
+def test_uniaxial_strain_small(name, options):
     """Compression to eps = -1e-6 in 1-D strain: sigma_xx = (K + 4G/3) eps,
     sigma_yy = sigma_zz = (K - 2G/3) eps, no shear, no failure; the recoverable
     energy is (K + 4G/3) eps^2 / 2 (within the EOS's higher-order terms)."""
-    mat = make(name)
+    mat = make(name, options)
     eps, t = -1e-6, 1e-6
     sigma, W, state, mode, J = drive(mat, [eps / t, 0, 0, 0, 0, 0], t)
     K, G, M, lam = linear(mat)
@@ -101,11 +112,11 @@ def test_uniaxial_strain_small(name):
     assert W[0] == pytest.approx(0.5 * M * eps * eps, rel=5e-3)
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_simple_shear_small(name):
+@pytest.mark.parametrize("name,options", CASES)
+def test_simple_shear_small(name, options):
     """A shear rate d_xy for a strain gamma/2 = 1e-6: sigma_xy = 2 G (gamma/2), no
     normal stress (isochoric, J = 1)."""
-    mat = make(name)
+    mat = make(name, options)
     e, t = 1e-6, 1e-6
     sigma, _, _, mode, _ = drive(mat, [0, 0, 0, 0, 0, e / t], t)
     _, G, _, _ = linear(mat)
@@ -114,10 +125,10 @@ def test_simple_shear_small(name):
     assert np.abs(sigma[0, :5]).max() <= 1e-9 * abs(sigma[0, 5])
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_isotropy(name):
+@pytest.mark.parametrize("name,options", CASES)
+def test_isotropy(name, options):
     """Relabelling the axes of the rate relabels the stress."""
-    mat = make(name)
+    mat = make(name, options)
     d = np.array([-3e-1, 1e-1, -0.5e-1, 0.2e-1, -0.4e-1, 0.7e-1])
     a = drive(mat, d, 1e-5, steps=50)[0][0]
     perm = [1, 2, 0]                          # x -> y -> z -> x: (yz, xz, xy) follow
@@ -127,20 +138,20 @@ def test_isotropy(name):
                                rtol=1e-12, atol=1e-9 * np.abs(a).max())
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_failed_point_is_left_alone(name):
+@pytest.mark.parametrize("name,options", CASES)
+def test_failed_point_is_left_alone(name, options):
     """A point with mode != 0 keeps its (zero) stress and its mode."""
     mode = np.array([1, 0], np.uint8)
-    sigma, _, _, mode, _ = drive(make(name), [-1.0, 0.5, 0, 0, 0, 0.3], 1e-6, n=2, mode=mode)
+    sigma, _, _, mode, _ = drive(make(name, options), [-1.0, 0.5, 0, 0, 0, 0.3], 1e-6, n=2, mode=mode)
     assert np.all(sigma[0] == 0.0) and mode[0] == 1
     assert np.any(sigma[1] != 0.0)
 
 
-@pytest.mark.parametrize("name", SOLIDS)
-def test_points_are_independent(name):
+@pytest.mark.parametrize("name,options", CASES)
+def test_points_are_independent(name, options):
     """Each point's stress depends on its own rate only: two different rates side by
     side give what each gives alone."""
-    mat = make(name)
+    mat = make(name, options)
     d = np.array([[-1.0, 0.5, 0, 0, 0, 0.3], [0.2, -0.1, -0.3, 0.1, 0, 0]])
     J_end = np.ones(2)
     idx = np.arange(2, dtype=np.int64)

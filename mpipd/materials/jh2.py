@@ -7,10 +7,24 @@ frame).
 
 Per point and step, in the unrotated frame (d from Eq. 6, dt):
 
-1. Compression mu = rho/rho0 - 1 = 1/J - 1 (J = det F).  Pressure (Eq. 25)
-       p = K1 mu + K2 mu^2 + K3 mu^3 + dp   (mu >= 0),   p = K1 mu + dp   (mu < 0).
-   The pressure comes from the EOS on the total compression, as in JH2; the
-   paper's Eq. 19 would integrate it incrementally, which contradicts Eq. 25.
+1. Pressure without bulking, p0, by the material's ``pressure`` choice:
+   * ``"eos"`` (the default): Eq. 25 on the total compression
+     mu = rho/rho0 - 1 = 1/J - 1 (J = det F at the end of the step),
+         p0 = K1 mu + K2 mu^2 + K3 mu^3   (mu >= 0),   p0 = K1 mu   (mu < 0)
+     (:func:`jh2_pressure`), as in JH2.  Table 1's cubic has a plateau at
+     p ~ 34-35 MPa, with dp/dmu < 0 for mu in 0.0042..0.0058 (:meth:`JH2.negative_tangent`).
+   * ``"incremental"``: Eq. 35's p_t = sigma'_v + dp_t, sigma'_v the hydrostatic
+     part of the linear elastic trial stress of Eq. 19,
+     sigma' = sigma + 2 G d dt + lambda I tr(d) dt, i.e. a history p_el
+     (compression positive, 0 at the start) with
+         p_el <- p_el - K1 tr(d) dt,   p0 = p_el,   K1 = lambda + 2G/3,
+     so p_el = -K1 ln J on any path (tr d = d ln J / dt).  Eq. 25 does not enter
+     (K1 is its bulk modulus; K2 and K3 are not used): the paper's Eq. 19 is
+     linear, and its Eqs. 25/26 are the EOS form that its own Eq. 35 does not use.
+     The paper's Figs. 14-15 (P1 yielding at p ~ 200 MPa with almost three times
+     the unconfined strength) need a pressure that keeps rising linearly, which
+     Table 1's cubic, with its plateau, does not give.
+   Then p = p0 + dp (dp: the bulking pressure, step 6).
 2. Tensile failure: p* = p / p_HEL < -T* (i.e. p < -T)  ->  the point fails (mode 2).
 3. Trial deviator S' = S + 2 G dev(d) dt (Eq. 19), von Mises s = sqrt(3/2 S':S') (Eq. 20).
 4. Strain rate (Eq. 24) edot = sqrt(2/3 dev(d):dev(d)), edot* = max(edot / edot_n, 1)
@@ -24,16 +38,18 @@ Per point and step, in the unrotated frame (d from Eq. 6, dt):
        D += deps_p / eps_f,  eps_f = D1 (p* + T*)^D2;  D >= 1  ->  the point fails (mode 1).
 6. Bulking (Eqs. 26–28): the strength lost to the damage step, at this p* and
    edot*, releases dU = [sigma_y(D_old)^2 - sigma_y(D_new)^2] / (6 G) > 0 and
-       dp <- -K1 mu + sqrt((K1 mu + dp)^2 + 2 beta K1 dU)
-   — only where the point is in compression (p >= 0 before the step).  Eq. 26
-   is the energy balance (p_new^2 - p_old^2) / (2 K1) = beta dU of a linear
-   pressure, which raises |p|; applied literally in tension (K1 mu + dp < 0)
-   its positive root flips the sign of p (-44 MPa -> +44 MPa), i.e. turns a
-   tensile point into a compressed one with no volume change.  Bulking is
-   dilatancy of crushed material under compression (Johnson & Holmquist 1994),
-   so in tension dp is left unchanged and dU is dissipated (the ledger's
-   ``plastic``).  In compression p only grows, so no yield step changes its sign.
-7. sigma = S - (p_EOS + dp) I (Eq. 35); the correspondence module rotates it (Eq. 36).
+       dp <- -p_lin + sqrt((p_lin + dp)^2 + 2 beta K1 dU),
+   p_lin the linear elastic pressure: K1 mu under ``"eos"`` (Eq. 26 as printed),
+   p_el under ``"incremental"`` — only where the point is in compression (p >= 0
+   before the step).  Eq. 26 is the energy balance (p_new^2 - p_old^2) / (2 K1)
+   = beta dU of a linear pressure, which raises |p|; applied literally in
+   tension (p_lin + dp < 0) its positive root flips the sign of p (-44 MPa ->
+   +44 MPa), i.e. turns a tensile point into a compressed one with no volume
+   change.  Bulking is dilatancy of crushed material under compression (Johnson
+   & Holmquist 1994), so in tension dp is left unchanged and dU is dissipated
+   (the ledger's ``plastic``).  In compression p only grows, so no yield step
+   changes its sign.
+7. sigma = S - (p0 + dp) I (Eq. 35); the correspondence module rotates it (Eq. 36).
 
 A failed point carries no stress; its bonds break (mpipd.model.failure).
 """
@@ -62,6 +78,12 @@ def jh2_pressure(mu, K1, K2, K3):
     return K1 * mu
 
 
+#: the choices of ``JH2.pressure`` (module docstring, step 1)
+PRESSURES = ("eos", "incremental")
+
+#: the ``p_el`` argument of the kernels under ``pressure = "eos"`` (not read)
+NO_P_EL = np.zeros(0)
+
 #: 8-point Gauss–Legendre nodes and weights on [-1, 1]
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
@@ -81,10 +103,34 @@ def eos_energy(mu, K1, K2, K3):
 
 
 @numba.njit(cache=True)
-def jh2_elastic_energy(idx, sigma, J, mode, G, K1, K2, K3, out):
-    """Recoverable energy per reference volume: J S:S / (4 G) + eos_energy(1/J - 1)
-    (the bulking pressure's work is not recoverable: it stays in the stress work,
-    on the dissipated side); 0 for failed points."""
+def linear_volumetric_energy(p_el, K1):
+    """Energy per reference volume stored by the linear hypoelastic pressure of
+    Eq. 19 (``pressure = "incremental"``) at the elastic pressure p_el: with
+    dp_el = -K1 d(ln J), p_el = -K1 ln J, and the stress work per reference
+    volume, -p dJ, integrates to
+        e_vol = -int_1^J p_el dJ' = K1 int_1^J ln J' dJ' = K1 (J ln J - J + 1)
+              = K1 [1 - (1 + x) exp(-x)],   x = p_el / K1 = -ln J,
+    >= 0 for either sign of x (1 + x <= exp(x)).  For |x| < 0.5 it is summed as
+    the series K1 sum_{n>=2} (n - 1) (-x)^n / n! = K1 (x^2/2 - x^3/3 + x^4/8 - ...),
+    which avoids the closed form's cancellation near x = 0."""
+    x = p_el / K1
+    if abs(x) < 0.5:
+        t = -x                          # (-x)^n / n!, n = 1
+        e = 0.0
+        for n in range(2, 30):
+            t *= -x / n
+            e += (n - 1) * t
+        return K1 * e
+    return K1 * (1.0 - (1.0 + x) * math.exp(-x))
+
+
+@numba.njit(cache=True)
+def jh2_elastic_energy(idx, sigma, J, mode, G, K1, K2, K3, p_el, incremental, out):
+    """Recoverable energy per reference volume: J S:S / (4 G) plus the volumetric
+    part, eos_energy(1/J - 1) under ``pressure = "eos"``, linear_volumetric_energy(p_el)
+    under ``"incremental"`` (p_el compact: entry k belongs to point idx[k]; empty
+    under "eos").  The bulking pressure's work is not recoverable: it stays in the
+    stress work, on the dissipated side.  0 for failed points."""
     for k in range(idx.shape[0]):
         i = idx[k]
         if mode[i] != 0:
@@ -94,7 +140,10 @@ def jh2_elastic_energy(idx, sigma, J, mode, G, K1, K2, K3, out):
         a, b, c = sigma[i, 0] - m, sigma[i, 1] - m, sigma[i, 2] - m
         ss = a * a + b * b + c * c + 2.0 * (sigma[i, 3] ** 2 + sigma[i, 4] ** 2
                                             + sigma[i, 5] ** 2)
-        out[i] = J[i] * ss / (4.0 * G) + eos_energy(1.0 / J[i] - 1.0, K1, K2, K3)
+        if incremental:
+            out[i] = J[i] * ss / (4.0 * G) + linear_volumetric_energy(p_el[k], K1)
+        else:
+            out[i] = J[i] * ss / (4.0 * G) + eos_energy(1.0 / J[i] - 1.0, K1, K2, K3)
 
 
 @numba.njit(cache=True, inline="always")
@@ -128,12 +177,20 @@ def strength_envelope(ps, rate, A, N, B, M, T_star):
 
 
 @numba.njit(cache=True)
-def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
+def jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, p_el, pressure, rate_out,
                G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
-               t_factor):
+               t_factor, incremental):
     """Advance the unrotated stress of the JH2 points ``idx`` (state arrays are
     compact: entry k belongs to point idx[k]).  Sets mode[i] on failure.
-    ``t_factor``: entry k's factor on T (mpipd.materials.heterogeneity), or empty."""
+    ``t_factor``: entry k's factor on T (mpipd.materials.heterogeneity), or empty.
+
+    ``incremental`` False (``pressure = "eos"``): p0 = Eq. 25 at mu = 1/J - 1
+    (:func:`jh2_pressure`; ``p_el`` is not read and may be empty).  True
+    (``"incremental"``, Eq. 35): p0 = p_el, the hydrostatic part of Eq. 19's trial
+    stress, p_el[k] -= K1 (d_xx + d_yy + d_zz) dt (d tension-positive: expansion
+    lowers p); J, K2 and K3 are not read.  Either way p = p0 + dp, with p* = p /
+    p_HEL in Eqs. 22, 23, 30 and the tensile check p < -T, and bulking (Eq. 26) on
+    p_lin = K1 mu or p_el (the module docstring, steps 1 and 6)."""
     hetero = t_factor.shape[0] > 0
     for k in range(idx.shape[0]):
         i = idx[k]
@@ -141,9 +198,15 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
             continue
         T = T0 * t_factor[k] if hetero else T0
         T_star = T / p_hel
-        mu = 1.0 / J[i] - 1.0
-        p_eos = jh2_pressure(mu, K1, K2, K3)
-        p = p_eos + dp[k]
+        if incremental:
+            p_el[k] -= K1 * (d[i, 0] + d[i, 1] + d[i, 2]) * dt
+            p_lin = p_el[k]
+            p0 = p_lin
+        else:
+            mu = 1.0 / J[i] - 1.0
+            p_lin = K1 * mu
+            p0 = jh2_pressure(mu, K1, K2, K3)
+        p = p0 + dp[k]
         pressure[k] = p
         if p < -T:
             mode[i] = MODE_TENSILE
@@ -179,9 +242,9 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
             sy_new = sigma_hel * jh2_strength(ps, rate, D_new, A, N, B, M, T_star)
             dU = (sy * sy - sy_new * sy_new) / (6.0 * G)
             if dU > 0.0 and p >= 0.0:
-                x = K1 * mu + dp[k]
-                dp[k] = -K1 * mu + math.sqrt(x * x + 2.0 * beta * K1 * dU)
-                p = p_eos + dp[k]
+                x = p_lin + dp[k]
+                dp[k] = -p_lin + math.sqrt(x * x + 2.0 * beta * K1 * dU)
+                p = p0 + dp[k]
                 pressure[k] = p
         sigma[i, 0] = s[0] - p
         sigma[i, 1] = s[1] - p
@@ -191,12 +254,26 @@ def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
         sigma[i, 5] = s[5]
 
 
+@numba.njit(cache=True)
+def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
+               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
+               t_factor):
+    """:func:`jh2_kernel` under ``pressure = "eos"`` (the argument list callers
+    before the ``pressure`` choice use)."""
+    jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, np.zeros(0), pressure, rate_out,
+               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
+               t_factor, False)
+
+
 @MATERIALS.register("jh2")
 @dataclass(frozen=True)
 class JH2(Material):
     """JH2 with the granite of the paper's Table 1 as defaults (SI units).
 
-    ``bulk_modulus`` is K1.  ``tension`` optionally adds the rate-dependent
+    ``bulk_modulus`` is K1.  ``pressure`` chooses the pressure of the stress
+    (module docstring, step 1): ``"eos"``, Eq. 25 on the total compression, or
+    ``"incremental"``, Eq. 35's hydrostatic part of Eq. 19's linear trial stress
+    (K2 and K3 then unused).  ``tension`` optionally adds the rate-dependent
     tension failure model (Eqs. 37–38).
     """
     density: float = 2660.0
@@ -216,6 +293,7 @@ class JH2(Material):
     D1: float = 0.005
     D2: float = 0.7
     rate_norm: float = 1.0                # edot_n of Eq. 22 (1/s)
+    pressure: str = "eos"                 # one of PRESSURES
     tension: TensionFailure | None = None
     heterogeneity: object = tagged(DISTRIBUTIONS, default=None)
 
@@ -225,6 +303,14 @@ class JH2(Material):
         non_negative(self, path, "C", "beta")
         if not self.HEL > self.p_HEL:
             fail(join(path, "HEL"), f"must exceed p_HEL ({self.HEL} <= {self.p_HEL})")
+        if self.pressure not in PRESSURES:
+            fail(join(path, "pressure"), f"must be one of {', '.join(map(repr, PRESSURES))} "
+                 f"(got {self.pressure!r})")
+
+    @property
+    def incremental(self) -> bool:
+        """True for ``pressure = "incremental"`` (Eq. 35), False for ``"eos"`` (Eq. 25)."""
+        return self.pressure == "incremental"
 
     @property
     def sigma_hel(self) -> float:
@@ -239,15 +325,22 @@ class JH2(Material):
         return super().strength_targets + ("T",)
 
     def new_state(self, n: int) -> dict:
-        return {"D": np.zeros(n), "eps_p": np.zeros(n), "dp": np.zeros(n),
-                "pressure": np.zeros(n), "strain_rate": np.zeros(n)}
+        """The history arrays; under ``pressure = "incremental"`` also ``p_el``, the
+        elastic hydrostatic pressure of Eq. 19 (Pa, compression positive, 0 at the start)."""
+        state = {"D": np.zeros(n), "eps_p": np.zeros(n), "dp": np.zeros(n),
+                 "pressure": np.zeros(n), "strain_rate": np.zeros(n)}
+        if self.incremental:
+            state["p_el"] = np.zeros(n)
+        return state
 
     def update(self, idx, d, J, dt, sigma, mode, state):
         s = state
-        jh2_update(idx, d, J, dt, sigma, mode, s["D"], s["eps_p"], s["dp"], s["pressure"],
-                   s["strain_rate"], self.shear_modulus, self.bulk_modulus, self.K2, self.K3,
-                   self.sigma_hel, self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T,
-                   self.beta, self.D1, self.D2, self.rate_norm, self.strength_factor(s, "T"))
+        jh2_kernel(idx, d, J, dt, sigma, mode, s["D"], s["eps_p"], s["dp"],
+                   s.get("p_el", NO_P_EL), s["pressure"], s["strain_rate"],
+                   self.shear_modulus, self.bulk_modulus, self.K2, self.K3, self.sigma_hel,
+                   self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T, self.beta,
+                   self.D1, self.D2, self.rate_norm, self.strength_factor(s, "T"),
+                   self.incremental)
 
     def point_strength(self, state: dict, pos: int) -> float:
         """sigma_y = sigma_HEL sigma* (p*, edot*, D) of one point (Eqs. 20–22, the
@@ -262,24 +355,36 @@ class JH2(Material):
 
     def elastic_energy(self, idx, sigma, J, mode, state, W, out):
         jh2_elastic_energy(idx, sigma, J, mode, self.shear_modulus, self.bulk_modulus,
-                           self.K2, self.K3, out)
+                           self.K2, self.K3, state.get("p_el", NO_P_EL), self.incremental, out)
 
     def p_wave_speed_at(self, mu):
-        """P-wave speed of the EOS at compression mu, in the reference configuration the
-        solver integrates in: the bulk stiffness is J dp/dJ = (1 + mu)^2 dp/dmu with
-        dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 (Eq. 26's tangent; K1 where that is smaller,
-        as in the negative-tangent range and in tension, where p = K1 mu), the density
-        rho0: sqrt(((1 + mu)^2 dp/dmu + 4G/3) / rho0).  (Measured critical steps of a
-        confined block at mu = 0.02 and 0.1 follow it within 5 %, once the EOS is
-        evaluated at the end-of-step J.)"""
+        """P-wave speed of the pressure law at compression mu, in the reference
+        configuration the solver integrates in: the bulk stiffness is
+        (1 + mu)^2 dp/dmu (= -dp/dJ, J = 1/(1 + mu)), the density rho0:
+        sqrt(((1 + mu)^2 dp/dmu + 4G/3) / rho0).
+
+        ``pressure = "eos"``: dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 (Eq. 26's tangent; K1
+        where that is smaller, as in the negative-tangent range and in tension, where
+        p = K1 mu).  (Measured critical steps of a confined block at mu = 0.02 and 0.1
+        follow it within 5 %, once the EOS is evaluated at the end-of-step J.)
+        ``"incremental"``: the bulk tangent dp/d(ln rho) is K1 at every mu (p_el =
+        K1 ln(1 + mu) on an elastic path; no stiffening, no negative-tangent range),
+        i.e. dp/dmu = K1 / (1 + mu) and (1 + mu)^2 dp/dmu = (1 + mu) K1."""
         mu = np.asarray(mu, dtype=float)
         k1 = self.bulk_modulus
-        tangent = np.maximum(k1 + 2.0 * self.K2 * mu + 3.0 * self.K3 * mu * mu, k1)
-        k = (1.0 + mu) ** 2 * np.where(mu > 0.0, tangent, k1)
+        if self.incremental:
+            k = (1.0 + mu) * k1
+        else:
+            tangent = np.maximum(k1 + 2.0 * self.K2 * mu + 3.0 * self.K3 * mu * mu, k1)
+            k = (1.0 + mu) ** 2 * np.where(mu > 0.0, tangent, k1)
         return np.sqrt(np.maximum(k + 4.0 * self.shear_modulus / 3.0, 0.0) / self.density)
 
     def negative_tangent(self) -> tuple[float, float] | None:
-        """The compression range (mu_lo, mu_hi) where dp/dmu = K1 + 2 K2 mu + 3 K3 mu^2 < 0."""
+        """The compression range (mu_lo, mu_hi) where Eq. 25's dp/dmu = K1 + 2 K2 mu +
+        3 K3 mu^2 < 0; None if there is none, and under ``pressure = "incremental"``
+        (the cubic is not used)."""
+        if self.incremental:
+            return None
         a, b, c = 3.0 * self.K3, 2.0 * self.K2, self.bulk_modulus
         if a == 0.0:
             return None if b >= 0 else (-c / b, math.inf)
