@@ -106,3 +106,19 @@ def test_overlapping_parts(tmp_path):
     f.write_text(text)
     out = tmp_path / "out"
     check_bad(run_cli(["run", str(f), "--out", str(out)]), out, "overlaps")
+
+
+def test_an_optional_table_is_switched_off_by_false():
+    """TOML has no null: ``false`` switches an optional table (X | None) off, so a
+    named case can take back a base scene's option (``contact=false``), while
+    ``true`` or a number there is still an error naming the key."""
+    from mpipd.input.scene import load
+    from mpipd.input.schema import SceneError
+    on = load("blast_demo", ["materials.explosive.contact={ distance = 0.9 }"])[0]
+    assert on.materials["explosive"].contact is not None
+    off = load("blast_demo", ["materials.explosive.contact={ distance = 0.9 }",
+                              "materials.explosive.contact=false"])[0]
+    assert off.materials["explosive"].contact is None
+    for bad in ("true", "1.0"):
+        with pytest.raises(SceneError, match="materials.explosive.contact"):
+            load("blast_demo", [f"materials.explosive.contact={bad}"])

@@ -91,6 +91,11 @@ def _coerce(tp, value, path):
         if value is None and type(None) in args:
             return None
         options = [a for a in args if a is not type(None)]
+        # an optional table (X | None, X a dataclass) is switched off by ``false``,
+        # TOML having no null: e.g. ``--set materials.explosive.contact=false``
+        if (value is False and type(None) in args
+                and all(dataclasses.is_dataclass(a) for a in options)):
+            return None
         if len(options) == 1:               # X | None: X's own error, with its own key path
             return _coerce(options[0], value, path)
         errors = []
