@@ -11,7 +11,22 @@
 Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
 sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
-zone, and the median for the count of major radial cracks; the crack orientation
+zone, and the median for the count of major radial cracks (information beside the
+paper's measures below); the paper's own measures:
+
+* major radial cracks (judged) on Fig. 11's sections, 5 mm from the detonation face,
+  mid-thickness and 5 mm from the far face, failed points linked only as lattice
+  neighbours (1.5 dx: :data:`postprocess.cracks.LATTICE_LINK`, why there), at the
+  last frame; the headline is the median of the three sections' counts;
+* the crushed zone at first damage (judged): the same rule
+  (:func:`postprocess.cracks.crushed_zone`) at the frame nearest 4 µs (Fig. 9a:
+  "damage is first observed surrounding the borehole as all points within a zone of
+  approximately one radius of the borehole are damaged"), if one lies within 1 µs of
+  it, on the same three sections; judged on the detonation end face, the view of
+  Fig. 9(a) (at 4 µs the detonation has not reached the far face), with the mean of
+  the three beside it; the last frame's mean (above) is information.
+
+The crack orientation
 (:mod:`postprocess.crack_orientation`: radial, oblique, circumferential, and the
 ring arcs) on the same sections, and the ring arcs again at every saved frame (a ring that
 forms and is overrun shows only there).  The lattice bias
@@ -33,7 +48,24 @@ from . import sections as secs
 from .targets import TARGETS, verdict
 
 CRACK_SECTIONS = (secs.NAMED[0], secs.NAMED[2], secs.NAMED[4])
+FIG11_SECTIONS = secs.FIG11  # the paper's count of major radial cracks (Fig. 11)
 PPV_THRESHOLD = 2.5          # m/s: the paper's "2500" (mm/s) of Bauer & Calder, Fig. 18
+FIRST_DAMAGE_US = 4.0        # Fig. 9(a): the crushed zone when damage is first seen
+FIRST_DAMAGE_TOL_US = 1.0    # the frame used must lie this close to it
+
+
+def first_damage_frame(times) -> dict:
+    """The saved frame nearest FIRST_DAMAGE_US (Fig. 9a, 4 µs; the first such frame on
+    a tie): ``{"frame", "t_us"}``, or not available if none lies within
+    FIRST_DAMAGE_TOL_US of it."""
+    t_us = np.asarray(times, float) * 1e6
+    if not len(t_us):
+        return {"not_available": "no frame"}
+    k = int(np.argmin(np.abs(t_us - FIRST_DAMAGE_US)))
+    if abs(t_us[k] - FIRST_DAMAGE_US) > FIRST_DAMAGE_TOL_US + 1e-9:     # saved times' rounding
+        return {"not_available": f"no saved frame within {FIRST_DAMAGE_TOL_US:g} µs of "
+                                 f"{FIRST_DAMAGE_US:g} µs (the nearest is at {t_us[k]:.3g} µs)"}
+    return {"frame": k, "t_us": float(t_us[k])}
 
 
 def pattern_frames(times, n=4, wanted_us=None) -> list[int]:
@@ -97,7 +129,63 @@ def ring_history(sections, model, frames, times, r_min_mm=None) -> dict:
             "largest": {"length_mm": mean[i], "frame": int(frames[i]), "t_us": t_us[i]}}
 
 
-def _fracture(data_sections, model, last, history=None, times=None) -> dict:
+def _fig11(data_sections, model, last, fig11) -> dict:
+    """Major radial cracks on Fig. 11's sections (``fig11``: name -> the gathered
+    section holding its level), failed points linked as lattice neighbours
+    (:data:`postprocess.cracks.LATTICE_LINK` dx), at the last frame; the median of the
+    sections' counts."""
+    per = {}
+    for name in FIG11_SECTIONS:
+        src = (fig11 or {}).get(name)
+        if src is None or src not in data_sections["sections"]:
+            continue
+        sec = data_sections["sections"][src]
+        failed, _ = cracks.failed_points(sec, last)
+        rc = cracks.radial_cracks(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                  model.r_wall, model.r_out,
+                                  horizon=cracks.LATTICE_LINK * sec["h"])
+        per[name] = {"z_mm": data_sections["levels"][src] * 1e3, "section": src, **rc}
+    if not per:
+        return {"not_available": "no Fig. 11 section in the rock"}
+    counts = [per[n]["count"] for n in per]
+    return {"sections": per, "link_dx": cracks.LATTICE_LINK,
+            "major_radial_cracks": float(np.median(counts)),
+            "rule": f"failed points linked within {cracks.LATTICE_LINK:g} dx (max-norm: the "
+                    "nearest and diagonal lattice neighbours, not the horizon); a crack is "
+                    "major when it runs from zone 1 into the outer 2 dx; median of the "
+                    f"{len(per)} sections"}
+
+
+def _first_damage(data_sections, model, first) -> dict:
+    """The crushed zone (:func:`postprocess.cracks.crushed_zone`) at the frame nearest
+    4 µs (``first``: :func:`first_damage_frame`) on CRACK_SECTIONS; the headline is
+    the detonation end face's (Fig. 9a's view), the mean of the sections beside it."""
+    if "not_available" in first:
+        return first
+    k, per = first["frame"], {}
+    for name in CRACK_SECTIONS:
+        if name not in data_sections["sections"]:
+            continue
+        sec = data_sections["sections"][name]
+        try:
+            failed, _ = cracks.failed_points(sec, k)
+        except KeyError:
+            return {"not_available": f"no damage or failure_mode at frame {k}"}
+        per[name] = cracks.crushed_zone(sec["x"], sec["y"], failed, model.center, sec["h"],
+                                        model.r_wall, model.r_out,
+                                        mode=sec.get(("failure_mode", k)))
+    face = per.get(secs.NAMED[0])
+    if face is None:
+        return {"not_available": "no detonation end face section"}
+    return {"frame": k, "t_us": first["t_us"], "section": secs.NAMED[0], "sections": per,
+            "extent_mm": face["extent_mm"], "extent_borehole_radii": face["extent_borehole_radii"],
+            "mean_extent_borehole_radii": float(np.mean(
+                [c["extent_borehole_radii"] for c in per.values()])),
+            "mean_extent_mm": float(np.mean([c["extent_mm"] for c in per.values()]))}
+
+
+def _fracture(data_sections, model, last, history=None, times=None, fig11=None,
+              first=None) -> dict:
     out = {}
     crit = None
     for name, z in data_sections["levels"].items():
@@ -133,7 +221,10 @@ def _fracture(data_sections, model, last, history=None, times=None) -> dict:
             "ring_arc_length_mm": float(np.mean([out[n]["orientation"]["ring_arc_length_mm"]
                                                  for n in names])),
             "ring_arcs": float(np.median([out[n]["orientation"]["ring_arcs"] for n in names])),
-            "ring_history": hist}
+            "ring_history": hist,
+            "fig11": _fig11(data_sections, model, last, fig11),
+            "first_damage": _first_damage(data_sections, model,
+                                          first or {"not_available": "not computed"})}
 
 
 def _lattice_bias(data_sections, model, last) -> dict:
@@ -186,11 +277,14 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     frames = pattern_frames(times, wanted_us=pattern_us)
     if last not in frames:
         frames.append(last)
-    zoned = secs.named_levels(secs.zone_levels(run, model), model)
+    levels = secs.zone_levels(run, model)
+    zoned = secs.named_levels(levels, model)
     named = {k: secs.section_z(v, model) for k, v in zoned.items()}
+    fig11 = {n: secs.same_level(n, levels[model.rock], named, model) for n in FIG11_SECTIONS}
+    first = first_damage_frame(times)
     history = [k for k in range(run.frames) if times[k] > 0]     # ring arcs at every frame
     reqs = ([("damage", k) for k in sorted(set(frames) | set(history))]
-            + [("failure_mode", last)])
+            + [("failure_mode", k) for k in sorted({last, first.get("frame", last)})])
     gathered = secs.gather_sections(run, model, zoned, reqs)
     sec_data = {"levels": named, "sections": gathered}
     prof_frames = profile_frames(times)
@@ -208,10 +302,11 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
                "probes": {n: {"d_mm": p["d"] * 1e3, "gid": p["gid"], "part": p["part"],
                               "material": p["material"],
                               "requested_part": p.get("requested_part"),
-                              "snap_distance_mm": p["snap_distance_mm"], "error": p["error"]}
+                              "snap_distance_mm": p["snap_distance_mm"], "error": p["error"],
+                              **pm.snap(p, n)}
                           for n, p in probes.items()}}
     metrics.update({k: vol[k] for k in ("energy", "failure_modes", "frame_series",
-                                         "gas_containment")})
+                                         "gas_containment", "tube_containment")})
     metrics.update(peaks.scan(run, model, probes))
     metrics["explosive_reference"] = explosive.reference(model, metrics["gas_pressure"],
                                                          metrics["wall_radial_stress"])
@@ -220,7 +315,7 @@ def analyse(run, model, pattern_us=None) -> tuple[dict, dict | None]:
     metrics["energy_ledger"] = ledger.read(run)
     metrics["global_energy_J"] = metrics["energy_ledger"].get("series_J", {})
     fr = (_fracture(sec_data, model, last, history if run.has_field("damage") else None,
-                    times) if run.root else None)
+                    times, fig11, first) if run.root else None)
     metrics["fracture"] = run.comm.bcast(fr, root=0)
     lb = _lattice_bias(sec_data, model, last) if run.root else None
     metrics["lattice_bias"] = run.comm.bcast(lb, root=0)
@@ -277,7 +372,11 @@ def target_values(m: dict) -> dict:
         "attenuation_n_first_pulse": _get(m["radial_stress"], "first_pulse_fit", "n"),
         **{f"crack_density_zone{k + 1}": (dens[k] if dens else fr) for k in range(3)},
         "major_radial_cracks": _get(fr, "major_radial_cracks"),
+        "major_radial_cracks_fig11": _get(fr, "fig11", "major_radial_cracks"),
         "crushed_zone": _get(fr, "crushed_extent_borehole_radii"),
+        "crushed_zone_first_damage": _get(fr, "first_damage", "extent_borehole_radii"),
+        "gas_outside_tube": _get(m["tube_containment"], "max_outside"),
+        "gas_beyond_tube_ends": _get(m["tube_containment"], "max_beyond_ends"),
         "ring_arc_length": _get(fr, "ring_arc_length_mm"),
         "ring_arc_length_largest": _get(fr, "ring_history", "largest", "length_mm"),
         "ppv_radius_2p5": _get(m["ppv_radius"], "value_mm"),
@@ -305,8 +404,13 @@ def _bases(m: dict) -> dict:
            "attenuation_n_first_pulse": (f"{rs['first_pulse_fit']['n_points']} probes"
                                          if "n_points" in rs.get("first_pulse_fit", {})
                                          else ""),
-           "major_radial_cracks": f"median of {ns} sections",
-           "crushed_zone": f"mean of {ns} sections",
+           "major_radial_cracks": f"median of {ns} sections (end faces, mid-thickness), "
+                                  "linked within the horizon",
+           "major_radial_cracks_fig11": _fig11_basis(fr),
+           "crushed_zone": f"mean of {ns} sections, last frame",
+           "crushed_zone_first_damage": _first_damage_basis(fr),
+           "gas_outside_tube": _tube_basis(m["tube_containment"]),
+           "gas_beyond_tube_ends": _tube_basis(m["tube_containment"], "beyond_ends"),
            "ring_arc_length": f"mean of {ns} sections",
            "ring_arc_length_largest": (
                f"mean of {ns} sections, largest at {fr['ring_history']['largest']['t_us']:.3g} µs"
@@ -316,6 +420,35 @@ def _bases(m: dict) -> dict:
            "peak_wall_pressure": m["wall_radial_stress"].get("basis", "")}
     out.update({f"crack_density_zone{k}": f"mean of {ns} sections" for k in (1, 2, 3)})
     return out
+
+
+def _fig11_basis(fr) -> str:
+    f = fr.get("fig11", {})
+    if "sections" not in f:
+        return ""
+    return (f"median of {len(f['sections'])} Fig. 11 sections ("
+            + ", ".join(str(s["count"]) for s in f["sections"].values())
+            + f"), linked within {f['link_dx']:g} dx")
+
+
+def _first_damage_basis(fr) -> str:
+    f = fr.get("first_damage", {})
+    if "frame" not in f:
+        return ""
+    return (f"detonation end face at {f['t_us']:.3g} µs; mean of {len(f['sections'])} "
+            f"sections {f['mean_extent_borehole_radii']:.2f}")
+
+
+def _tube_basis(tc, key="outside") -> str:
+    if "t_us" not in tc:
+        return ""
+    series = tc[key]
+    bad = [i for i, v in enumerate(series) if v > 0]
+    if not bad:
+        return f"largest over {len(series)} frames: 0 at every frame to {tc['t_us'][-1]:.3g} µs"
+    i = bad[0]
+    return (f"largest over {len(series)} frames; first nonzero at {tc['t_us'][i]:.3g} µs "
+            f"(frame {i}: {series[i]} points)")
 
 
 def target_bounds(m: dict) -> dict:

@@ -26,6 +26,13 @@ The charge is the part of a ``jwl`` material (or ``charge``); ``explosive`` is i
 material (JWL constants, Table 2) when the scene parses.
 ``peak_center`` is the axis of the run's ``peak_sigma_rr`` field (the scene's
 ``[output] peak_center``, default (0, 0)).
+
+``tubes`` are the tubes that hold a charge (paper Fig. 6: the copper tube inside the
+borehole), from the parsed scene only: a part that is an annulus, not a zone of the
+rock and not of a ``jwl`` material, around a ``jwl`` part that is a cylinder on the
+same axis (within the tube's dx) no wider than the tube's inner radius + its dx.
+Each is ``{"part", "name", "center", "r_in", "r_out", "z", "dx", "charges"}``
+(``charges``: the part indices of the charges it holds).  No scene, no tube.
 """
 from __future__ import annotations
 
@@ -72,6 +79,7 @@ class Model:
     part_material: dict = field(default_factory=dict)   # part index -> material name
     explosive_materials: tuple = ()              # names of the jwl materials (the gas)
     probe_parts: dict = field(default_factory=dict)     # probe name -> its scene ``part``
+    tubes: list = field(default_factory=list)    # the tubes holding a charge (docstring)
     overrides: list = field(default_factory=list)
     notes: list = field(default_factory=list)
 
@@ -243,6 +251,7 @@ def load_model(run, label: str | None = None) -> Model:
         if charge is not None and part_mat.get(charge) in scene.materials:
             explosive = scene.materials[part_mat[charge]]
             pf = getattr(explosive, "pressure_factor", None)
+    tubes = _tubes(parts, sparts, models, rock_ids)
     name = str(run.attr("scene_name", scene.name if scene is not None else "unknown"))
     return Model(label=label or name, scene_name=name, center=center, r_wall=r_wall,
                  r_out=r_out, z0=z0, z1=z1, dx=float(dx), rock=rock, charge=charge,
@@ -251,5 +260,27 @@ def load_model(run, label: str | None = None) -> Model:
                  rock_ids=rock_ids, zone_dx=zone_dx, zone_horizon=zone_horizon,
                  wall_dx=float(wall_dx), explosive=explosive,
                  peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts,
-                 explosive_materials=explosives)
+                 explosive_materials=explosives, tubes=tubes)
+
+
+def _tubes(parts, sparts, models, rock_ids) -> list[dict]:
+    """The tubes that hold a charge (module docstring), from the scene's parts."""
+    out = []
+    charges = [(k, sparts[n]) for k, n in enumerate(parts) if models[k] == "jwl" and n in sparts]
+    for k, n in enumerate(parts):
+        sp = sparts.get(n)
+        if sp is None or k in rock_ids or models[k] == "jwl" or not hasattr(sp.shape, "inner_radius"):
+            continue
+        sh, dx = sp.shape, float(sp.dx)
+        held = [c for c, cp in charges
+                if not hasattr(cp.shape, "inner_radius") and hasattr(cp.shape, "radius")
+                and hasattr(cp.shape, "center")
+                and np.hypot(cp.shape.center[0] - sh.center[0],
+                             cp.shape.center[1] - sh.center[1]) <= dx
+                and cp.shape.radius <= sh.inner_radius + dx]
+        if held:
+            out.append({"part": k, "name": n, "center": (float(sh.center[0]), float(sh.center[1])),
+                        "r_in": float(sh.inner_radius), "r_out": float(sh.radius),
+                        "z": (float(sh.z[0]), float(sh.z[1])), "dx": dx, "charges": held})
+    return out
 

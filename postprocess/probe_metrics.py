@@ -5,6 +5,12 @@ wall, P1–P3 at 0.8, 1.6 and 4.8 mm (paper Figs. 6, 15), ``wall`` on the rock's
 first layer.  A probe's distance d is measured from its actual lattice point,
 d = |x - x_c| - R_b.
 
+A probe's point is the lattice point nearest its requested position
+(mpipd.output.probes); the report gives, per probe, the requested and the snapped
+distance from the wall and flags a probe moved more than half the dx of its
+point's part (3-D distance from the requested position, :func:`snap`): blast_paper's
+P1–P3 (Fig. 15: 0.8, 1.6, 4.8 mm) sit at 0.42, 1.22 and 4.41 mm.
+
 A probe must sample the material it names.  A file written with the probe's part
 (``/probes/<name>`` attributes ``part``, ``requested_part``) is checked against
 ``/geometry/part`` of the probe's gid; an older file against the ``part`` of the
@@ -54,6 +60,7 @@ PATHS = {"P1": 0.8, "P2": 1.6, "P3": 4.8}
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength")
 OPTIONAL = ("t_state",)         # absent from files written before 2026-12: t_state = t
 YIELD_TOL = 0.99
+SNAP_FLAG = 0.5             # a probe moved more than this many dx of its part is flagged
 ROCK_PROBES = ("wall", *SERIES, *PATHS)
 
 
@@ -79,11 +86,33 @@ def load_probes(run, model) -> dict:
             data = {q: a[keep] for q, a in data.items()}
             gid = int(g.attrs["gid"])
             x = run.f["geometry/x"][gid]
-            data.update(gid=gid, x=x.tolist(),
+            pid = int(run.f["geometry/part"][gid])
+            dx = (float(g.attrs["dx"]) if "dx" in g.attrs else model.dx_of(pid)
+                  if pid in model.zone_ids else float(np.cbrt(run.f["geometry/volume"][gid])))
+            want = g.attrs.get("position")
+            data.update(gid=gid, x=x.tolist(), dx=dx,
+                        position=None if want is None else [float(c) for c in want],
                         d=float(np.hypot(x[0] - model.center[0], x[1] - model.center[1])
                                 - model.r_wall), **_placement(run, model, name, g, gid))
+            if want is not None:
+                data["requested_d"] = float(np.hypot(want[0] - model.center[0],
+                                                     want[1] - model.center[1]) - model.r_wall)
             out[name] = data
     return run.comm.bcast(out, root=0)
+
+
+def snap(p: dict, name: str) -> dict:
+    """How far a probe's snap moved it: the requested and the snapped distance from the
+    wall (mm), the paper's distance of a named probe (A–G, P1–P3), the dx of its part
+    (mm) and whether the snap moved it more than SNAP_FLAG dx (3-D distance from the
+    requested position; None if the file does not say)."""
+    dist = p.get("snap_distance_mm")
+    if dist is None and p.get("position") is not None:
+        dist = float(np.linalg.norm(np.subtract(p["x"], p["position"]))) * 1e3
+    req = p.get("requested_d")
+    return {"snap_distance_mm": dist, "requested_d_mm": None if req is None else req * 1e3,
+            "paper_d_mm": {**SERIES, **PATHS}.get(name), "dx_mm": p["dx"] * 1e3,
+            "moved_beyond_half_dx": None if dist is None else bool(dist > SNAP_FLAG * p["dx"] * 1e3)}
 
 
 def _attr(g, key):

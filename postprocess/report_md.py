@@ -93,7 +93,8 @@ def render(doc) -> str:
     L += _fracture(doc["fracture"]) + _fig(doc, "fig12_crack_density")
     L += _orientation(doc["fracture"])
     L += _lattice_bias(doc["lattice_bias"])
-    L += _probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc) + _containment(doc)
+    L += (_probes(doc) + _radial(doc) + _ppv(doc) + _paths(doc) + _pressure(doc)
+          + _containment(doc) + _tube(doc))
     L += _energy(doc)
     na = [f"- {r['label']}: {r['verdict'][len('not available: '):]}" for r in doc["targets"]
           if r["verdict"].startswith("not available")]
@@ -116,13 +117,29 @@ def _probes(doc) -> list[str]:
     if not pr:
         return []
     L = ["## Probes (recorded every step)", "",
-         "| probe | d from the wall (mm) | part | material | requested part | "
-         "snapped (mm from the requested position) | check |", "|---|---|---|---|---|---|---|"]
+         "Each probe samples the lattice point nearest its requested position; d is the "
+         "distance from the borehole wall, requested (the scene's position) and sampled (the "
+         "snapped point's); a snap of more than dx/2 of the point's part (3-D distance from "
+         "the requested position) is flagged.", "",
+         "| probe | d requested (mm) | d sampled (mm) | paper d (mm) | part | material | "
+         "requested part | snapped (mm from the requested position) | dx/2 (mm) | check |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
+    warn = []
     for n, p in pr.items():
-        L.append(f"| {n} | {p['d_mm']:.3g} | {p.get('part', '—')} | {p.get('material', '—')} | "
-                 f"{p.get('requested_part') or '—'} | {_f(p.get('snap_distance_mm'))} | "
+        moved = p.get("moved_beyond_half_dx")
+        half = None if p.get("dx_mm") is None else 0.5 * p["dx_mm"]
+        L.append(f"| {n} | {_f(p.get('requested_d_mm'))} | {p['d_mm']:.3g} | "
+                 f"{_f(p.get('paper_d_mm'))} | {p.get('part', '—')} | {p.get('material', '—')} | "
+                 f"{p.get('requested_part') or '—'} | {_f(p.get('snap_distance_mm'))}"
+                 f"{' (**> dx/2**)' if moved else ''} | {_f(half)} | "
                  f"{'**error**: ' + p['error'] if p.get('error') else 'ok'} |")
-    return L + [""]
+        if moved:
+            warn.append(f"Warning: probe {n} was moved {p['snap_distance_mm']:.3g} mm by its snap "
+                        f"(more than dx/2 = {half:.3g} mm): requested "
+                        f"{_f(p.get('requested_d_mm'))} mm from the wall"
+                        + (f" (paper {p['paper_d_mm']:g} mm)" if p.get("paper_d_mm") else "")
+                        + f", sampled at {p['d_mm']:.3g} mm.")
+    return L + [""] + (warn + [""] if warn else [])
 
 
 def _fracture(fr) -> list[str]:
@@ -143,7 +160,11 @@ def _fracture(fr) -> list[str]:
     L += [f"| mean | | {md[0]:.3f} | {md[1]:.3f} | {md[2]:.3f} | "
           f"{fr['major_radial_cracks']:.3g} (median) | {fr['crushed_extent_mm']:.3g} / "
           f"{fr['crushed_extent_borehole_radii']:.2f} |",
-          "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", ""]
+          "| experiment | | 0.30–0.46 | 0.10–0.18 | 0.05–0.13 | paper: 6 | paper: ≈ 1 R_b |", "",
+          "This table's radial cracks (failed points linked within the horizon, on the end faces "
+          "and mid-thickness) and crushed zone (last frame) are information; the judged count "
+          "and crushed zone follow.", ""]
+    L += _fig11(fr.get("fig11")) + _first_damage(fr.get("first_damage"))
     shares = [(name, s["crushed_zone"].get("mode_share")) for name, s in fr["sections"].items()]
     if any(m for _, m in shares):
         L += ["What failed the crushed zone's points (share of its failed points by the "
@@ -152,6 +173,47 @@ def _fracture(fr) -> list[str]:
                   f"{name}: " + ", ".join(f"{k} {v:.2f}" for k, v in m.items() if v)
                   for name, m in shares if m) + ".", ""]
     return L
+
+
+def _fig11(f) -> list[str]:
+    L = ["### Major radial cracks on Fig. 11's sections (the judged count)", ""]
+    if f is None:
+        return L + ["Not in this report (made before the Fig. 11 count).", ""]
+    if _na(f):
+        return L + [f"Not available: {f['not_available']}.", ""]
+    L += [f"The paper counts on Fig. 11's sections: 5 mm from the detonation face, "
+          f"mid-thickness, 5 mm from the far face, at the last frame.  Linking: failed points "
+          f"are one crack only when they are lattice neighbours, within {f['link_dx']:g} dx "
+          "(max-norm: nearest and diagonal neighbours), not within a horizon: cracks two or three "
+          "spacings apart, and the late boundary damage that reaches a crack, are separate cracks "
+          "on the section but lie within one horizon, which would merge them "
+          "(`postprocess/cracks.py`).  A crack is major when it runs from zone 1 into the outer "
+          "2 dx.  Headline: the median of the sections' counts.", "",
+          "| Fig. 11 section | z (mm) | major radial cracks | angles (deg) | boundary arcs |",
+          "|---|---|---|---|---|"]
+    for name, s in f["sections"].items():
+        same = f" (the level of the {s['section']})" if s["section"] != name else ""
+        L.append(f"| {name}{same} | {s['z_mm']:.3g} | {s['count']} | "
+                 f"{', '.join(f'{a:.0f}' for a in s['angles_deg']) or '—'} | {s['boundary_arcs']} |")
+    return L + [f"| median | | {f['major_radial_cracks']:.3g} | paper: 6 | |", ""]
+
+
+def _first_damage(f) -> list[str]:
+    L = ["### Crushed zone at first damage (Fig. 9a, 4 µs; judged)", ""]
+    if f is None:
+        return L + ["Not in this report (made before the first-damage measure).", ""]
+    if _na(f):
+        return L + [f"Not available: {f['not_available']}.", ""]
+    L += [f"The same rule as above (the unbroken run of rings of width dx from the wall with "
+          f"at least 90 % of their points failed) at frame {f['frame']}, t = {f['t_us']:.3g} µs, "
+          "the saved frame nearest 4 µs (Fig. 9a: \"all points within a zone of approximately "
+          "one radius of the borehole are damaged\").  Judged: the detonation end face, Fig. "
+          "9(a)'s view; the last frame's mean above is information.", "",
+          "| section | crushed zone (mm beyond wall / R_b) |", "|---|---|"]
+    for name, c in f["sections"].items():
+        L.append(f"| {name} | {c['extent_mm']:.3g} / {c['extent_borehole_radii']:.2f} |")
+    return L + [f"| mean | {f['mean_extent_mm']:.3g} / {f['mean_extent_borehole_radii']:.2f} |",
+                "| paper (Fig. 9a) | ≈ 1 R_b |", ""]
 
 
 def _orientation(fr) -> list[str]:
@@ -402,6 +464,27 @@ def _containment(doc) -> list[str]:
             if pas is None else f"passive there (no gas neighbourhood, no force): at most "
             f"{max(pas)}."), ""]
     return L
+
+
+def _tube(doc) -> list[str]:
+    t = doc.get("tube_containment")
+    if t is None or _na(t):
+        return []
+    L = ["### Gas containment by the tube", "",
+         f"Rule (`postprocess/tube.py`): {t['rule']}.  Tube(s): "
+         + ", ".join(f"{n} ({g} gas points, {i} inner-layer points, {b[0]} x {b[1]} bins in "
+                     "z x angle)" for n, g, i, b in zip(t["tubes"], t["gas_points"],
+                                                       t["inner_layer_points"], t["bins"]))
+         + ".  With an intact tube no gas point is outside it.", "",
+         "| frame | t (µs) | gas points outside the tube | beyond its ends |", "|---|---|---|---|"]
+    L += [f"| {k} | {tu:.3g} | {o} | {b} |"
+          for k, (tu, o, b) in enumerate(zip(t["t_us"], t["outside"], t["beyond_ends"]))]
+    L.append("")
+    f = t["first_outside"]
+    L.append("Outside the tube: none at any frame." if f is None else
+             f"Outside the tube first at {f['t_us']:.3g} µs (frame {f['frame']}): {f['points']} "
+             f"gas points; at most {t['max_outside']}.")
+    return L + [""]
 
 
 def _energy(doc) -> list[str]:

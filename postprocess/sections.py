@@ -23,6 +23,8 @@ import numpy as np
 
 #: the named sections of a specimen of thickness T (z0 = the detonation end)
 NAMED = ("detonation end face", "z0 + 5 mm", "mid-thickness", "z1 - 5 mm", "far end face")
+#: paper Fig. 11's sections: 5 mm from the detonation face, the middle, 5 mm from the far face
+FIG11 = (NAMED[1], NAMED[2], NAMED[3])
 
 
 def zone_levels(run, model) -> dict[int, np.ndarray]:
@@ -39,14 +41,29 @@ def nearest(levels: np.ndarray, z: float) -> float:
     return float(levels[np.argmin(np.abs(levels - z))])
 
 
+def wanted(model) -> dict[str, float]:
+    """Section name -> the height it is wanted at (before taking a lattice level)."""
+    z0, z1 = model.z0, model.z1
+    return {NAMED[0]: z0, NAMED[1]: z0 + 5e-3, NAMED[2]: 0.5 * (z0 + z1),
+            NAMED[3]: z1 - 5e-3, NAMED[4]: z1}
+
+
+def same_level(name: str, ref_levels, named: dict[str, float], model) -> str | None:
+    """The section of ``named`` (name -> its reference zone's level) that holds the level
+    ``name`` is wanted at: itself, or the one that took its level when
+    :func:`named_levels` dropped it as a duplicate (a thin specimen: Fig. 11's
+    "z1 - 5 mm" may be the far end face's level)."""
+    z = nearest(np.asarray(ref_levels), wanted(model)[name])
+    hit = [n for n, zn in named.items() if zn == z]
+    return (name if name in hit else hit[0]) if hit else None
+
+
 def named_levels(levels: dict[int, np.ndarray], model) -> dict[str, dict[int, float]]:
     """Section name -> {zone: z level}, for the faces, +-5 mm from the faces and the
     middle.  The reference zone's level nearest the wanted height names the section
     (duplicates dropped when the specimen is thin); every other zone takes its own
     level nearest that one."""
-    z0, z1 = model.z0, model.z1
-    want = {NAMED[0]: z0, NAMED[1]: z0 + 5e-3, NAMED[2]: 0.5 * (z0 + z1),
-            NAMED[3]: z1 - 5e-3, NAMED[4]: z1}
+    want = wanted(model)
     ref = levels[model.rock]
     out, seen = {}, set()
     for name in (NAMED[0], NAMED[4], NAMED[2], NAMED[1], NAMED[3]):

@@ -33,12 +33,18 @@ rank reads one frame of one field of its own slice at a time).
   carry no force and coast; without it every point counts as acting.  Any acting
   point in intact rock makes the block an error naming the largest count and
   fraction of the charge; passive ones are counted beside it.
+* Gas containment by the tube, per frame (:mod:`postprocess.tube`): the gas points
+  outside the copper tube's current inner surface within its length, and those
+  beyond its ends.  Absent (not available) without a tube holding a charge or
+  without the ``u`` field.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from mpipd.kernels.layout import MODE_LABELS, N_MODES
+
+from . import tube
 
 NEGATIVE_TOL = 1e-9          # relative: a rock energy below -tol * max |E| is an error
 
@@ -80,11 +86,16 @@ def scan(run, model, profile_frames) -> dict:
         if q < len(zdx):
             zdx[q] = model.dx_of(q)
     h_rock = zdx[pid[rock]]
+    held = (tube.Containment(run, model, x, pid)
+            if run.has_field("u") and model.tubes else None)
     prof = {}
     for k in range(nf):
+        u = run.field("u", k) if has_u or held is not None else None   # this rank's slice
         if has_u:
-            in_rock[k], in_intact[k], passive[k] = _gas_in_rock(run, model, x, ig, rock,
+            in_rock[k], in_intact[k], passive[k] = _gas_in_rock(run, model, x, u, ig, rock,
                                                                 h_rock, k, has_force)
+        if held is not None:
+            held.frame(k, u)
         if has_v and rock_rho_known:
             v = run.field("v", k)
             ek[:, k] = run.per_level(np.where(rock, 0.5 * vol * rho * (v ** 2).sum(1), 0.0))
@@ -136,15 +147,16 @@ def scan(run, model, profile_frames) -> dict:
     out["gas_containment"] = (_containment(in_rock, in_intact, run.sum_int(int(gas.sum())),
                                            run.time, passive if has_force else None)
                               if has_u else {"not_available": "no u field or no explosive"})
+    out["tube_containment"] = (held.result() if held is not None else {"not_available": (
+        "no tube holding a charge in the scene" if not model.tubes else "no u field")})
     return out
 
 
-def _gas_in_rock(run, model, x, ig, rock, h_rock, k, has_force) -> tuple[int, int, int]:
-    """Frame k: the explosive's points inside the rock's volume, those inside intact
-    rock that act on it, and the passive ones there (module docstring); collective
-    (every rank gets the counts)."""
+def _gas_in_rock(run, model, x, u, ig, rock, h_rock, k, has_force) -> tuple[int, int, int]:
+    """Frame k (``u``: this rank's displacements at it): the explosive's points inside
+    the rock's volume, those inside intact rock that act on it, and the passive ones
+    there (module docstring); collective (every rank gets the counts)."""
     from scipy.spatial import cKDTree
-    u = run.field("u", k)                               # this rank's slice, read once
     y = np.concatenate(run.comm.allgather(x[ig] + u[ig]))           # every gas point, on every rank
     acts = (np.concatenate(run.comm.allgather(run.field("gas_force", k)[ig] > 0.0))
             if has_force else np.ones(len(y), bool))

@@ -204,6 +204,30 @@ def test_changed_verdict_is_flagged(tmp_path, capsys):
     assert row[0] == TARGETS[k].label and row[6] == "**within** (report.json: outside)"
 
 
+def test_report_made_before_the_paper_measures(tmp_path, capsys):
+    """A report.json made when the horizon-linked crack count and the last frame's
+    crushed zone were judged, without the paper's measures (the Fig. 11 count, the
+    crushed zone at 4 µs, the gas outside the tube): the former rows show today's
+    'information' beside their stored verdict, the new rows 'not in report.json'."""
+    new = ("major_radial_cracks_fig11", "crushed_zone_first_damage", "gas_outside_tube",
+           "gas_beyond_tube_ends")
+    doc = report_json("old", {t.key: inside(t) for t in TARGETS})
+    doc["targets"] = [r for r in doc["targets"] if r["key"] not in new]
+    for r in doc["targets"]:
+        if r["key"] in ("major_radial_cracks", "crushed_zone"):
+            r["value"], r["kind"], r["verdict"] = 6.0 if r["key"] == "major_radial_cracks" \
+                else 1.0, "range", "within"
+    d = write_report(tmp_path / "old" / "report", doc)
+    assert main(["validate", "--out", str(tmp_path / "v" / "validation"), str(d)]) == 0
+    md = (tmp_path / "v" / "validation.md").read_text()
+    rows = {r[0]: r for r in table(md, "## Targets")[2:]}
+    by = {t.key: t for t in TARGETS}
+    assert rows[by["major_radial_cracks"].label][5:] == ["6", "information (report.json: within)"]
+    assert rows[by["crushed_zone"].label][5:] == ["1", "information (report.json: within)"]
+    for key in new:
+        assert rows[by[key].label][5:] == ["—", "not in report.json"]
+
+
 def test_without_lattice_bias_and_notes(two_reports, capsys):
     tmp, a, b, *_ = two_reports
     out = tmp / "v" / "validation"
