@@ -151,6 +151,7 @@ def _run(args, team, signals=None) -> int:
 
     bad_input = (SceneError, DecompositionError, UsageError, ck.CheckpointError,
                  rundir.RunDirError)
+    lock = None
     try:
         if args.stop_after is not None and args.stop_after < 1:
             raise UsageError(f"--stop-after must be a step >= 1 (got {args.stop_after})")
@@ -163,6 +164,7 @@ def _run(args, team, signals=None) -> int:
             text = info.scene
             overrides = info.overrides + list(args.set)
             scene = sc.parse(text, str(args.restart), overrides)
+            rundir.check_same_physics(sc.parse(text, str(args.restart), info.overrides), scene)
             out = Path(args.out) if args.out else Path(args.restart).resolve().parent
         else:
             if not args.scene:
@@ -176,10 +178,21 @@ def _run(args, team, signals=None) -> int:
             if n_steps < info.step:
                 raise UsageError(f"the run length ({n_steps} steps) ends before the "
                                  f"checkpoint's step {info.step}")
-            _on_root(team, rundir.check_restart, out, info.run_id, text, info.n_points,
-                     scene.output.every, scene.time.dt)
+
+            def restart_checks():
+                return rundir.check_restart(out, info.run_id, text, info.n_points,
+                                            scene.output.every, scene.time.dt, info.step,
+                                            n_steps)
+            if _on_root(team, restart_checks):
+                if team.root:
+                    print(f"mpipd: {h5} is complete to step {n_steps} of {n_steps}: nothing "
+                          "to do (nothing written; set a longer time.t_end or time.steps to "
+                          "extend it)", flush=True)
+                return 0
         else:
-            _on_root(team, rundir.check_new_run, out, args.overwrite)
+            def new_run_checks():
+                rundir.check_new_run(out, args.overwrite)
+            _on_root(team, new_run_checks)
         check_parts(scene.parts)             # geometry first: empty, oversized, overlapping
         dt_stable = critical_dt(scene)
         if scene.time.dt > dt_stable and not args.force:
@@ -188,30 +201,48 @@ def _run(args, team, signals=None) -> int:
         sim = Simulation(scene, team)
         if args.restart:
             ck.restore(sim, args.restart)
-        _on_root(team, rundir.ensure_writable, out)          # the first write of the run
+        # the first write of the run: the folder's lock, then the checks again under it
+        # (another run may have started or finished since)
+        lock = rundir.RunLock(out) if team.root else None
+        _on_root(team, lock.acquire if team.root else None)
+        if args.restart:
+            _on_root(team, restart_checks)
+        else:
+            _on_root(team, new_run_checks)
+        _on_root(team, rundir.ensure_writable, out)
     except bad_input as e:
+        if lock is not None:
+            lock.release(remove_dir=True)
         return _bad_input(team, e)
-    if args.restart:
-        run_id, resume, shown = info.run_id, True, _shown(text, overrides)
-    else:
-        run_id, resume, shown = team.bcast(rundir.new_run_id() if team.root else None), \
-            False, _shown(text, overrides)
-        if args.overwrite and team.root:
-            rundir.clear_old_run(out)
-    team.barrier()
+    except BaseException:
+        if lock is not None:
+            lock.release()
+        raise
     try:
-        return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
-                       n_steps, dt_stable, run_id, resume)
-    except Exception as e:
-        line = rundir.io_line(e, out)
-        if line is None:
-            raise
-        for tmp in out.glob("*.h5.tmp"):         # a checkpoint that did not finish
-            try:
-                tmp.unlink()
-            except OSError:
-                pass
-        raise rundir.IOFailure(line) from None
+        if args.restart:
+            run_id, resume, shown = info.run_id, True, _shown(text, overrides)
+        else:
+            run_id, resume, shown = team.bcast(rundir.new_run_id() if team.root else None), \
+                False, _shown(text, overrides)
+            if args.overwrite and team.root:
+                rundir.clear_old_run(out)
+        team.barrier()
+        try:
+            return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
+                           n_steps, dt_stable, run_id, resume)
+        except Exception as e:
+            line = rundir.io_line(e, out)
+            if line is None:
+                raise
+            for tmp in out.glob("*.h5.tmp"):         # a checkpoint that did not finish
+                try:
+                    tmp.unlink()
+                except OSError:
+                    pass
+            raise rundir.IOFailure(line) from None
+    finally:
+        if lock is not None:
+            lock.release()
 
 
 def _shown(text: str, overrides) -> str:
@@ -221,16 +252,18 @@ def _shown(text: str, overrides) -> str:
 
 
 def _on_root(team, fn, *args):
-    """Run a serial check on rank 0; its error (or None) is raised on every rank."""
-    err = None
+    """Run a serial check on rank 0; its error is raised on every rank, else its
+    value returned on every rank."""
+    err = value = None
     if team.root:
         try:
-            fn(*args)
+            value = fn(*args)
         except Exception as e:               # re-raised on every rank below
             err = e
-    err = team.bcast(err)
+    err, value = team.bcast((err, value))
     if err is not None:
         raise err
+    return value
 
 
 def _end_checkpoint(checkpointer, team, out) -> str | None:
@@ -306,7 +339,8 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         return {"from_step": first, "to_step": sim.step_count, "ranks": team.size,
                 "wall_s": round(w, 3),
                 "bond_steps_per_s": sim.n_bonds_global * done / w if w > 0 else None,
-                "bond_states_evaluated": round(sim.classes.evaluated_share(team), 4)}
+                "bond_states_evaluated": round(sim.classes.evaluated_share(team), 4),
+                **({"restart_set": list(args.set)} if args.restart else {})}
     try:
         wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
                        checkpointer=checkpointer)

@@ -7,6 +7,18 @@ A run directory ``OUT`` holds one run's files::
     OUT/run.log             the log (appended to by restarts)
     OUT/checkpoint.h5       the last checkpoint (mpipd.output.checkpoint), attribute ``run_id``
     OUT/checkpoint_failed.h5  the state at a blow-up
+    OUT/run.lock            held (flock) by the run's rank 0 for the run's whole life
+
+A run folder holds one live run at a time: rank 0 takes an exclusive ``flock``
+on ``OUT/run.lock`` before it writes anything (:class:`RunLock`) and keeps it to
+the end; a second run or a restart into the folder meanwhile is refused (exit 2,
+one line naming the holder's pid and host).  The kernel drops the lock when its
+process dies, however it dies, so a lock file left by a killed job is stale and
+the next run takes it over.
+
+A restart continues the same physics (:func:`scene_changes`): only the run length,
+the checkpoint and progress cadence and the ledger's stop bound may change; it
+never rewrites a frame it does not write again (:func:`check_frames`).
 
 A run draws a random **run id** when it creates ``run.h5`` and writes it into
 every checkpoint it makes.  A restart continues the run file of its own run
@@ -20,9 +32,14 @@ the outcome.
 """
 from __future__ import annotations
 
+import dataclasses
 import errno
+import fcntl
+import json
 import os
 import re
+import socket
+import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +48,7 @@ from ..parallel.team import Fatal
 
 RUN_FILE = "run.h5"
 CHECKPOINT = "checkpoint.h5"
+LOCK = "run.lock"
 #: files of the old run that ``--overwrite`` removes (run.h5 and run.xdmf are rewritten)
 OLD_RUN_FILES = ("checkpoint.h5", "checkpoint.h5.tmp", "checkpoint_failed.h5",
                  "checkpoint_failed.h5.tmp", "run.log")
@@ -52,6 +70,21 @@ class RunFile:
     n_points: int
     every: int
     dt: float
+    steps: int = -1              # the run length the file is sized for
+    frames_written: int = 0
+    n_alloc: int = 0             # frames the file has room for (/time's length)
+
+    @property
+    def finished(self) -> bool:
+        return self.n_alloc > 0 and self.frames_written == self.n_alloc
+
+    def frame_step(self, k: int) -> int:
+        """The step of frame ``k``: every ``every`` steps, the last at ``steps``."""
+        return min(k * self.every, self.steps)
+
+    @property
+    def last_step_written(self) -> int:
+        return self.frame_step(self.frames_written - 1) if self.frames_written > 0 else -1
 
 
 def read_run_file(h5: Path) -> RunFile:
@@ -61,7 +94,9 @@ def read_run_file(h5: Path) -> RunFile:
             a = f.attrs
             return RunFile(str(a["run_id"]) if "run_id" in a else None, str(a.get("scene", "")),
                            int(a.get("n_points", -1)), int(a.get("every", -1)),
-                           float(a.get("dt", 0.0)))
+                           float(a.get("dt", 0.0)), int(a.get("steps", -1)),
+                           int(a.get("frames_written", 0)),
+                           int(f["time"].shape[0]) if "time" in f else 0)
     except (OSError, KeyError, ValueError) as e:
         raise RunDirError(f"{h5}: cannot read the run file ({e})") from None
 
@@ -80,12 +115,15 @@ OVERRIDES_MARK = "\n# overrides (--set)\n"
 
 
 def check_restart(out: Path, ck_run_id: str | None, scene_text: str, n_points: int,
-                  every: int, dt: float) -> None:
+                  every: int, dt: float, ck_step: int | None = None,
+                  n_steps: int | None = None) -> bool:
     """A restart from a checkpoint of run ``ck_run_id`` into ``out``: the run file
     there must be that run's (the same run id, scene TOML ``scene_text`` without
     overrides -- a restart may add some -- and point count ``n_points``), and the
     frame layout must stay: a restart may change the run length, not the frame
-    spacing ``every`` or the step ``dt``, since frames are indexed by step // every."""
+    spacing ``every`` or the step ``dt``, since frames are indexed by step // every.
+    Given the checkpoint's step and the new run length, also :func:`check_frames`;
+    returns True when the run is finished at that length (nothing to do)."""
     if out.exists() and not out.is_dir():
         raise RunDirError(f"--out {out} exists and is not a directory")
     h5 = out / RUN_FILE
@@ -108,6 +146,212 @@ def check_restart(out: Path, ck_run_id: str | None, scene_text: str, n_points: i
                           "the frames in the run file are indexed by step")
     if rf.dt != dt:
         raise RunDirError(f"a restart cannot change time.dt ({rf.dt:g} -> {dt:g} s)")
+    if ck_step is None or n_steps is None:
+        return False
+    return check_frames(rf, ck_step, n_steps, every)
+
+
+#: scene keys a restart may change: the run length, the checkpoint and progress
+#: cadence, the ledger's stop bound and the description (output.every may not
+#: change either, check_restart says why; everything else is the run's physics or
+#: the run file's layout)
+RESTART_MAY_CHANGE = ("time.steps", "time.t_end", "output.checkpoint_every",
+                      "solver.progress_every", "solver.max_imbalance", "scene.description")
+
+
+def _diff(a, b, path: str, out: list) -> None:
+    """Append to ``out`` the key paths where scene values ``a`` and ``b`` differ
+    (dataclasses field by field, tables key by key, arrays of tables entry by
+    entry; an array of plain values is one value)."""
+    import numpy as np
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        if type(a) is not type(b):
+            out.append(path)
+            return
+        for f in dataclasses.fields(a):
+            if f.init:
+                _diff(getattr(a, f.name), getattr(b, f.name),
+                      f"{path}.{f.name}" if path else f.name, out)
+        return
+    if isinstance(a, dict):
+        if not isinstance(b, dict):
+            out.append(path)
+            return
+        for k in list(a) + [k for k in b if k not in a]:
+            if k not in a or k not in b:
+                out.append(f"{path}.{k}")
+            else:
+                _diff(a[k], b[k], f"{path}.{k}", out)
+        if list(a) != list(b) and set(a) == set(b):    # the order numbers the materials
+            out.append(path)
+        return
+    if isinstance(a, (tuple, list)) and any(dataclasses.is_dataclass(v) for v in a):
+        if not isinstance(b, (tuple, list)) or len(a) != len(b):
+            out.append(path)
+            return
+        for i, (x, y) in enumerate(zip(a, b)):
+            _diff(x, y, f"{path}[{i}]", out)
+        return
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        if not (np.shape(a) == np.shape(b) and np.array_equal(a, b)):
+            out.append(path)
+        return
+    if type(a) is not type(b) or a != b:
+        out.append(path)
+
+
+def _shown_value(scene, path: str) -> str:
+    """The value at key path ``path`` of a scene, short, for a message."""
+    node = scene
+    for part in re.findall(r"[^.\[\]]+", path):
+        try:
+            node = (node[int(part)] if part.isdigit() and isinstance(node, (tuple, list))
+                    else node[part] if isinstance(node, dict) else getattr(node, part))
+        except (KeyError, IndexError, AttributeError, TypeError):
+            return "(absent)"
+    if dataclasses.is_dataclass(node):
+        return "(a table)"
+    text = json.dumps(list(node) if isinstance(node, tuple) else node, default=str)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def scene_changes(old, new) -> list[str]:
+    """The key paths where scene ``new`` (a restart's) differs from ``old`` (its
+    checkpoint's) other than RESTART_MAY_CHANGE, in scene order."""
+    diffs: list[str] = []
+    _diff(old, new, "", diffs)
+    return [d for d in diffs if d not in RESTART_MAY_CHANGE]
+
+
+def check_same_physics(old, new) -> None:
+    """A restart continues its run: refuse (one line naming the first key) a scene
+    that differs from the checkpoint's beyond RESTART_MAY_CHANGE.  output.every and
+    time.dt keep check_restart's own lines."""
+    from ..input.schema import SceneError
+    changed = [d for d in scene_changes(old, new) if d not in ("output.every", "time.dt")]
+    if changed:
+        key = changed[0]
+        more = f" (and {len(changed) - 1} more key(s))" if len(changed) > 1 else ""
+        raise SceneError(key, f"a restart continues its run and cannot change it "
+                              f"({_shown_value(old, key)} -> {_shown_value(new, key)}){more}; "
+                              "a restart may change only " + ", ".join(RESTART_MAY_CHANGE)
+                         + " (rerun the scene with --out elsewhere for other values)")
+
+
+def check_frames(rf: RunFile, ck_step: int, n_steps: int, every: int) -> bool:
+    """A restart from step ``ck_step`` with run length ``n_steps`` into run file
+    ``rf``: refuse (RunDirError) one that would drop or overwrite a frame the file
+    holds and the restart does not write again -- a frame after the new end, or an
+    off-cadence last frame (a finished run's step that is no multiple of ``every``)
+    whose row a longer run gives another step.  Returns True when there is nothing
+    to do: the file is finished at exactly this run length and the checkpoint is at
+    its end (the restart then writes nothing)."""
+    last = rf.last_step_written
+    if n_steps == ck_step:
+        if rf.finished and rf.steps == n_steps:
+            return True
+        raise RunDirError(f"the run length ({n_steps} steps) ends at the checkpoint's step "
+                          f"{ck_step}: nothing to run (set a longer time.t_end or time.steps)")
+    if last > n_steps:
+        raise RunDirError(f"the run file holds frames to step {last}; a run length of {n_steps} "
+                          "steps would drop them (set time.t_end or time.steps to reach it)")
+    if last >= 0 and last % every and last != n_steps:
+        raise RunDirError(f"the run file's last frame is at step {last}, off the output.every = "
+                          f"{every} cadence (the end of a run of {rf.steps} steps); a run of "
+                          f"{n_steps} steps would write step {last - last % every + every}'s "
+                          "frame into its row (frames are indexed by step // every): to extend "
+                          f"a run later, give it a run length that is a multiple of {every}")
+    return False
+
+
+class RunLock:
+    """An exclusive ``flock`` on ``OUT/run.lock``, held by rank 0 from before the
+    run's first write to its end.  The file names its holder (pid, host, time).
+    The kernel releases a flock when its process dies, so a lock left by a killed
+    run is free; :meth:`release` unlinks the file while still holding it, and
+    :meth:`acquire` checks that the file it locked is still the one at the path (a
+    process that opened the old file just before the unlink must not think it
+    holds a lock)."""
+
+    def __init__(self, out: Path):
+        self.path = Path(out) / LOCK
+        self.fd = None
+        self.made_dir = False
+
+    def acquire(self) -> "RunLock":
+        out = self.path.parent
+        if out.exists() and not out.is_dir():
+            raise RunDirError(f"--out {out} exists and is not a directory")
+        try:
+            if not out.exists():
+                out.mkdir(parents=True)
+                self.made_dir = True
+            for _ in range(20):
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                except BlockingIOError:
+                    holder = self._holder(fd)
+                    os.close(fd)
+                    raise RunDirError(f"{out} is in use by another mpipd run ({holder}); one "
+                                      "run per folder: wait for it, or use another --out") from None
+                try:
+                    same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+                except FileNotFoundError:
+                    same = False
+                if same:
+                    self.fd = fd
+                    break
+                os.close(fd)                 # unlinked by its holder meanwhile: again
+            else:
+                raise RunDirError(f"cannot take the lock {self.path} (it keeps changing)")
+            os.ftruncate(self.fd, 0)
+            os.write(self.fd, json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                                          "since": time.strftime("%Y-%m-%d %H:%M:%S")}).encode())
+            os.fsync(self.fd)
+        except OSError as e:
+            self._undo()
+            raise RunDirError(f"cannot write to --out {out}: {e.strerror or e}") from None
+        return self
+
+    @staticmethod
+    def _holder(fd) -> str:
+        try:
+            d = json.loads(os.pread(fd, 4096, 0).decode() or "{}")
+            return f"pid {d['pid']} on {d['host']} since {d['since']}"
+        except (OSError, ValueError, KeyError, TypeError):
+            return "its lock file names no holder yet"
+
+    def _undo(self):
+        if self.fd is not None:
+            try:
+                os.unlink(self.path)
+            except OSError:
+                pass
+            os.close(self.fd)
+            self.fd = None
+        if self.made_dir:
+            try:
+                self.path.parent.rmdir()
+            except OSError:
+                pass
+
+    def release(self, remove_dir: bool = False):
+        """Unlink the lock file and drop the lock; ``remove_dir``: also remove the
+        folder if this run made it and it is empty (a run refused before writing)."""
+        if self.fd is None:
+            return
+        try:
+            os.unlink(self.path)
+        except OSError:
+            pass
+        os.close(self.fd)
+        self.fd = None
+        if remove_dir and self.made_dir:
+            try:
+                self.path.parent.rmdir()
+            except OSError:
+                pass
 
 
 def ensure_writable(out: Path) -> None:

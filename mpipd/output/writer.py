@@ -124,26 +124,34 @@ class Writer:
         self.fields = scene.output.fields
         self.n_frames = n_frames(n_steps, self.every)
         self.frame_no = 0
+        self.held = 0
         comm = sim.team.comm
         self.commit = sim.team.bcast(git_commit() if sim.team.root else None)
         if resume:
             self.f = h5py.File(self.path, "r+", driver="mpio", comm=comm)
             self.run_id = str(self.f.attrs["run_id"])
-            self.f.attrs["scene"] = scene_text         # with the restart's overrides
+            # the scene attribute stays the run's: a restart changes no physics
+            # (rundir.check_same_physics); its own --set are in its ``segments`` entry
             self.dsets = {name: self.f["fields"][name] for name in self.fields}
             self.time = self.f["time"]
             self.energy = {k: self.f["energy"][k] for k in self.f["energy"]}
             self.frame_no = sim.step_count // self.every + 1
+            # frames the file holds beyond the checkpoint (a run killed after it) stay
+            # counted until they are written again (rundir.check_frames keeps them in
+            # the new run length)
+            self.held = int(self.f.attrs.get("frames_written", 0))
             self.bonds = self.f["bonds"] if "bonds" in self.f else None
             if self.time.shape[0] != self.n_frames:          # a new run length
                 for d in (*self.dsets.values(), self.time, *self.energy.values()):
                     d.resize(self.n_frames, axis=0)
                 if self.bonds is not None:
                     self.bonds["offsets"].resize(self.n_frames + 1, axis=0)
+            if int(self.f.attrs["steps"]) != n_steps:
                 self.f.attrs["steps"] = n_steps
             if self.bonds is not None:       # frames after the checkpoint are written again
+                # (the rows past it stay until then: a restart stopped before them
+                # keeps those frames whole; _broken_bonds resizes from here)
                 self.bond_rows = int(self.bonds["offsets"][self.frame_no])
-                self.bonds["broken"].resize(self.bond_rows, axis=0)
             if sim.probes is not None:
                 sim.probes.create(self.f, n_steps + 1)
             return
@@ -233,7 +241,7 @@ class Writer:
         self.frame_no += 1
         if sim.probes is not None:
             sim.probes.flush()
-        self.f.attrs["frames_written"] = self.frame_no
+        self.f.attrs["frames_written"] = self.frames_written
         self.f.flush()                  # a crash loses at most the frames since this one
         return e
 
@@ -262,7 +270,7 @@ class Writer:
             segs = json.loads(old if isinstance(old, str) else old.decode())
             segs.append({**segment, "git_commit": self.commit})
             self.f.attrs["segments"] = json.dumps(segs)
-        self.f.attrs["frames_written"] = self.frame_no
+        self.f.attrs["frames_written"] = self.frames_written
         self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()
         if self.sim.gas is not None:    # every step's peak, not just the frames' (since start/restart)
@@ -273,8 +281,14 @@ class Writer:
         self.f.close()
         if self.sim.team.root:
             times, geometry = self.time_values()
-            write_xdmf(self.path, self.sim.n_global, self.fields, self.frame_no,
+            write_xdmf(self.path, self.sim.n_global, self.fields, self.frames_written,
                        times, self.n_frames, geometry)
+
+    @property
+    def frames_written(self) -> int:
+        """Frames the file holds: this invocation's, or more when a restart has not
+        yet reached the frames an earlier invocation wrote after its checkpoint."""
+        return max(self.frame_no, self.held)
 
     def time_values(self):
         """The frames' times and the per-point geometry datasets (name -> "Int" or
@@ -283,7 +297,7 @@ class Writer:
         with h5py.File(self.path, "r") as f:
             geo = {k: ("Int" if d.dtype.kind == "i" else "Float")
                    for k, d in f["geometry"].items() if d.ndim == 1}
-            return f["time"][: self.frame_no], geo
+            return f["time"][: self.frames_written], geo
 
 
 def _xdmf_field_item(h5: str, name: str, k: int, shape, column: int | None = None) -> list:

@@ -1,0 +1,189 @@
+"""Issue 61: nothing a run wrote is lost or hidden by a later command.
+
+A restart of a finished run writes nothing; a restart never rewrites the frame
+counter downwards, never drops a frame it does not write again, and refuses
+changed physics or output fields (exit 2, one line, every file unchanged)."""
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from conftest import ROOT, run_cli
+
+SMALL = ["--set", "parts.0.dx=0.002", "--set", "time.dt=2e-7", "--set", "time.t_end=1.2e-5",
+         "--set", "output.every=20", "--quiet"]
+
+
+def md5s(folder: Path) -> dict:
+    return {p.name: hashlib.md5(p.read_bytes()).hexdigest()
+            for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def one_error(res, *needles, code=2):
+    assert res.returncode == code, res.stdout + res.stderr
+    assert "Traceback" not in res.stderr, res.stderr
+    lines = {ln for ln in res.stderr.splitlines() if ln.startswith("mpipd")}
+    assert len(lines) == 1, res.stderr
+    line = lines.pop()
+    assert line.startswith("mpipd: error: "), line
+    for n in needles:
+        assert n in line, line
+    return line
+
+
+def runstate(out: Path) -> str:
+    res = subprocess.run([sys.executable, str(ROOT / "jobs/lib/runstate.py"), str(out)],
+                         capture_output=True, text=True)
+    return res.stdout.strip()
+
+
+def frames(h5: Path) -> dict:
+    """Every frame dataset's written rows, the counter and the time axis."""
+    with h5py.File(h5, "r") as f:
+        n = int(f.attrs["frames_written"])
+        d = {k: f[k][:n] for k in ("time", "fields/u", "fields/v")}
+        d["frames_written"] = n
+        d["scene"] = str(f.attrs["scene"])
+        return d
+
+
+# ----------------------------------------------------------------- data loss 1
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished run of 50 steps (frames 0, 20, 40 and the off-cadence 50)."""
+    out = tmp_path_factory.mktemp("fin") / "fin"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set", "time.steps=50",
+                   "--set", "output.checkpoint_every=10"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    return out
+
+
+def test_restart_of_a_finished_run_writes_nothing(finished):
+    before = md5s(finished)
+    res = run_cli(["run", "--restart", str(finished / "checkpoint.h5")])
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "nothing to do" in res.stdout
+    assert md5s(finished) == before
+    with h5py.File(finished / "run.h5", "r") as f:
+        assert int(f.attrs["frames_written"]) == 4 and f["time"][3] == pytest.approx(1e-5)
+    assert runstate(finished) == "done 50 50"
+    assert "frame3" in (finished / "run.xdmf").read_text()
+
+
+@pytest.mark.parametrize("length", ["time.steps=100", "time.steps=40", "time.t_end=2e-5"])
+def test_extending_past_an_off_cadence_last_frame_is_refused(finished, length):
+    before = md5s(finished)
+    res = run_cli(["run", "--restart", str(finished / "checkpoint.h5"), "--set", length])
+    if length == "time.steps=40":
+        one_error(res, "ends before the checkpoint's step 50")
+    else:
+        one_error(res, "last frame is at step 50", "output.every = 20")
+    assert md5s(finished) == before
+
+
+def test_extending_a_finished_run_keeps_its_frames(tmp_path):
+    """On cadence (40 steps, every 20): the extension adds frames, the old stay."""
+    out = tmp_path / "o"
+    assert run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set", "time.steps=40",
+                    "--set", "output.checkpoint_every=20"]).returncode == 0
+    old = frames(out / "run.h5")
+    res = run_cli(["run", "--restart", str(out / "checkpoint.h5"), "--set", "time.steps=60"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    new = frames(out / "run.h5")
+    assert new["frames_written"] == 4 and old["frames_written"] == 3
+    for k in ("time", "fields/u", "fields/v"):
+        assert np.array_equal(new[k][:3], old[k]), k
+    assert new["scene"] == old["scene"]              # the run's scene, not rewritten
+    with h5py.File(out / "run.h5", "r") as f:
+        segs = json.loads(f.attrs["segments"])
+        assert [s["to_step"] for s in segs] == [40, 60]
+        assert segs[1]["restart_set"] == ["time.steps=60"]
+        assert int(f.attrs["steps"]) == 60
+    assert runstate(out) == "done 60 60"
+
+
+@pytest.mark.mpi
+def test_an_early_stop_keeps_frames_written_after_the_checkpoint(tmp_path):
+    """A checkpoint at step 20 of a run whose file holds frames to step 60 (as after
+    a kill past the checkpoint): a restart stopped at 40 keeps frame 60 counted and
+    whole (its broken-bond rows included), and frames 0-40 bitwise the same."""
+    out = tmp_path / "o"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"],
+                  ranks=2)
+    assert res.returncode == 0, res.stdout + res.stderr
+    at20 = tmp_path / "ck20.h5"
+    shutil.copy(out / "checkpoint.h5", at20)
+    assert run_cli(["run", "--restart", str(out / "checkpoint.h5")], ranks=2).returncode == 0
+    full = frames(out / "run.h5")
+    assert full["frames_written"] == 4
+    res = run_cli(["run", "--restart", str(at20), "--out", str(out), "--stop-after", "40"],
+                  ranks=2)
+    assert res.returncode == 0, res.stdout + res.stderr
+    after = frames(out / "run.h5")
+    assert after["frames_written"] == 4
+    for k in ("time", "fields/u", "fields/v"):
+        assert np.array_equal(after[k], full[k]), k
+    # and a shorter run length would drop frame 60: refused
+    shutil.copy(at20, tmp_path / "again.h5")
+    before = md5s(out)
+    res = run_cli(["run", "--restart", str(tmp_path / "again.h5"), "--out", str(out),
+                   "--set", "time.steps=40"])
+    one_error(res, "holds frames to step 60")
+    assert md5s(out) == before
+
+
+# ----------------------------------------------------------------- data loss 2, defect 5
+
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory):
+    out = tmp_path_factory.mktemp("stopped") / "s"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    return out
+
+
+@pytest.mark.parametrize("setting,key", [
+    ('output.fields=["u"]', "output.fields"),
+    ('output.fields=["u","v","stress"]', "output.fields"),
+    ("materials.granite.bulk_modulus=30e9", "materials.granite.bulk_modulus"),
+    ("materials.granite.density=5000", "materials.granite.density"),
+    ("parts.0.shape.hi=[0.016, 0.192, 0.016]", "parts[0].shape.hi"),
+    ("solver.hourglass=0.02", "solver.hourglass"),
+    ('probes=[{name="a", position=[0.05, 0.008, 0.008]}]', "probes"),
+    ("output.peak_center=[0.1, 0.0]", "output.peak_center"),
+])
+def test_restart_refuses_changed_physics_and_fields(stopped, setting, key):
+    before = md5s(stopped)
+    res = run_cli(["run", "--restart", str(stopped / "checkpoint.h5"), "--set", setting])
+    one_error(res, f"error: {key}: a restart continues its run")
+    assert md5s(stopped) == before
+
+
+@pytest.mark.mpi
+def test_restart_refuses_other_fields_on_two_ranks(stopped):
+    before = md5s(stopped)
+    res = run_cli(["run", "--restart", str(stopped / "checkpoint.h5"), "--set",
+                   'output.fields=["u","v","stress"]'], ranks=2)
+    one_error(res, "output.fields")
+    assert md5s(stopped) == before
+
+
+def test_restart_may_change_cadence_and_length(tmp_path):
+    out = tmp_path / "o"
+    assert run_cli(["run", "elastic_wave", "--out", str(out), *SMALL,
+                    "--stop-after", "20"]).returncode == 0
+    old = frames(out / "run.h5")
+    res = run_cli(["run", "--restart", str(out / "checkpoint.h5"), "--set",
+                   "output.checkpoint_every=20", "--set", "solver.progress_every=10",
+                   "--set", "time.t_end=1.6e-5", "--set", "solver.max_imbalance=0.1"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    new = frames(out / "run.h5")
+    assert new["frames_written"] == 5
+    for k in ("time", "fields/u", "fields/v"):
+        assert np.array_equal(new[k][:2], old[k][:2]), k
