@@ -187,3 +187,76 @@ def test_restart_may_change_cadence_and_length(tmp_path):
     assert new["frames_written"] == 5
     for k in ("time", "fields/u", "fields/v"):
         assert np.array_equal(new[k][:2], old[k][:2]), k
+
+
+# ----------------------------------------------------------------- data loss 3: one run per folder
+
+def _hold_lock(folder: Path):
+    import fcntl
+    import os
+    folder.mkdir(parents=True, exist_ok=True)
+    fd = os.open(folder / "run.lock", os.O_RDWR | os.O_CREAT)
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    os.write(fd, json.dumps({"pid": os.getpid(), "host": "here", "since": "now"}).encode())
+    return fd
+
+
+def test_a_folder_in_use_is_refused_and_a_stale_lock_taken_over(tmp_path, stopped):
+    import os
+    out = tmp_path / "o"
+    fd = _hold_lock(out)
+    try:
+        res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL])
+        one_error(res, "in use by another mpipd run", f"pid {os.getpid()} on here")
+        assert [p.name for p in out.iterdir()] == ["run.lock"]
+    finally:
+        os.close(fd)                       # as a killed run's: the file stays, unlocked
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL])
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert not (out / "run.lock").exists()          # released and removed at the end
+    # a restart into a folder in use
+    before = md5s(stopped)
+    fd = _hold_lock(stopped)
+    try:
+        before_lock = md5s(stopped)
+        res = run_cli(["run", "--restart", str(stopped / "checkpoint.h5")])
+        one_error(res, "in use by another mpipd run")
+        assert md5s(stopped) == before_lock
+    finally:
+        os.close(fd)
+        (stopped / "run.lock").unlink()
+    assert md5s(stopped) == before
+
+
+def test_bad_input_leaves_no_folder(tmp_path):
+    out = tmp_path / "new"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set",
+                   'probes=[{name="far", position=[0.5, 0.0, 0.0]}]'])
+    one_error(res, "probes[0].position")
+    assert not out.exists()
+
+
+@pytest.mark.mpi
+def test_two_runs_started_at_once_into_one_folder(tmp_path):
+    """Both at once on 2 ranks each: exactly one runs, the other is refused (the
+    lock, or the run file it finds under the lock); the file is the winner's."""
+    from conftest import BIN, child_env
+    out = tmp_path / "o"
+    cmds = [["mpirun", "--oversubscribe", "-n", "2", str(BIN / "mpipd"), "run", "elastic_wave",
+             "--out", str(out), *SMALL, *extra]
+            for extra in ([], ["--set", "materials.granite.density=3000"])]
+    ps = [subprocess.Popen(c, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           env=child_env()) for c in cmds]
+    res = [(p.wait(timeout=300), *p.communicate()) for p in ps]
+    codes = sorted(r[0] for r in res)
+    assert codes == [0, 2], res
+    loser = next(r for r in res if r[0] == 2)
+    lines = {ln for ln in loser[2].splitlines() if ln.startswith("mpipd")}
+    assert len(lines) == 1 and ("in use by another mpipd run" in lines.pop()
+                                or "exists" in loser[2]), loser[2]
+    winner = res.index(next(r for r in res if r[0] == 0))
+    with h5py.File(out / "run.h5", "r") as f:
+        assert ("density=3000" in str(f.attrs["scene"])) == (winner == 1)
+        assert int(f.attrs["frames_written"]) == f["time"].shape[0] == 4
+        assert np.isfinite(f["fields/u"][...]).all()
+    assert not (out / "run.lock").exists()
