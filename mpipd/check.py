@@ -33,6 +33,7 @@ copper blocks, so the refusal is conservative.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -213,6 +214,86 @@ def wave_speed_limit(mat, c_max: float):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if float(mat.p_wave_speed_at(mid)) >= c_max else (mid, hi)
     return hi
+
+
+#: a run file's bytes besides its frames, geometry and probes (HDF5 headers, attributes)
+RUN_FILE_OVERHEAD = 1 << 20
+#: per point of /geometry: x (3 f8), volume (f8), material and part (i4), room for
+#: z_level and a strength factor (f8 each)
+GEOMETRY_BYTES = 24 + 8 + 4 + 4 + 16
+
+
+def run_file_bytes(scene, n_points: int) -> int:
+    """The run file's size as ``mpipd run`` allocates it before step 1
+    (mpipd.output.writer): every frame of every output field (8 bytes a component),
+    the time and ledger rows, the geometry, every probe's row per step and the
+    bond offsets (the broken bonds grow with the run and are not counted)."""
+    from .input.scene import OUTPUT_FIELDS
+    from .model.ledger import TERMS
+    from .output.probes import QUANTITIES
+    from .output.writer import n_frames
+    n_steps = scene.time.n_steps
+    frames = n_frames(n_steps, scene.output.every)
+    per_frame = 8 * n_points * sum(OUTPUT_FIELDS[f][0] for f in scene.output.fields) \
+        + 8 * (2 + len(TERMS))
+    probes = 8 * len(QUANTITIES) * (n_steps + 1) * len(scene.probes)
+    return frames * per_frame + GEOMETRY_BYTES * n_points + probes + RUN_FILE_OVERHEAD
+
+
+@dataclass
+class Sizes:
+    """What a run needs before it is built: points, bonds, the model's bytes on each
+    rank of the decomposition, and the run file's bytes."""
+    points: int
+    bonds: int
+    memory: list          # bytes per rank (the model's arrays, memory_model)
+    run_file: int
+
+
+def rank_memory(scene, table, slabs, bonds, ranks: int) -> list[int]:
+    """The model's bytes on each rank (:func:`memory_model`, bonds, the gas's lists)."""
+    per_local, per_owned = memory_model(scene)
+    acted = {a for m in scene.gas_materials for a in scene.materials[m].interacts_with}
+    ul_parts = [k for k, q in enumerate(scene.parts)
+                if is_gas_part(scene, q) or q.material in acted]
+    gas_points = int(sum(int(table.count[table.part == k].sum())
+                         for k, q in enumerate(scene.parts) if is_gas_part(scene, q)))
+    out = []
+    for r in range(ranks):
+        owned, ghost = slabs.points_of(r)
+        a, b = slabs.owned(r)
+        nb = int(bonds[a:b].sum())
+        held = np.concatenate((np.arange(a, b), slabs.ghost_layers(r)))
+        ul_points = int(table.count[held][np.isin(table.part[held], ul_parts)].sum())
+        out.append(per_local * (owned + ghost) + per_owned * owned + BYTES_PER_BOND * nb
+                   + BYTES_PER_GAS_POINT * gas_points + BYTES_PER_UL_POINT * ul_points)
+    return out
+
+
+def sizes(scene, ranks: int) -> Sizes:
+    """:class:`Sizes` from the layer table (nothing is built)."""
+    table = LayerTable.from_parts(scene.parts, scene.material_ids)
+    slabs = decompose(table, ranks, halo_width(scene), replicated_parts(scene))
+    bonds = layer_bonds(scene, table)
+    return Sizes(int(table.n_points), int(bonds.sum()),
+                 rank_memory(scene, table, slabs, bonds, ranks),
+                 run_file_bytes(scene, int(table.n_points)))
+
+
+def mem_available() -> int | None:
+    """This host's MemAvailable (bytes), None where /proc/meminfo has none."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def gb(n: float) -> str:
+    return f"{n / 1e9:.3g} GB"
 
 
 def check_report(scene, ranks: int) -> str:
@@ -397,6 +478,24 @@ def check_report(scene, ranks: int) -> str:
         out.append(f"  note: {thin} slab(s) thinner than the halo ({halo:.4g} m): their ghosts "
                    "come from ranks beyond the neighbours (handled by the multi-hop halo, "
                    "at the cost of more messages); fewer ranks avoid it")
+    mems = rank_memory(scene, table, slabs, bonds, ranks)
+    avail = mem_available()
+    total = sum(mems)
+    line = (f"  memory: the model's arrays {gb(max(mems))} on the largest rank, {gb(total)} "
+            f"on {ranks} rank(s)")
+    if avail is not None:
+        line += f"; this machine has {gb(avail)} available"
+        if total > avail:
+            line += (" - WARNING: all ranks on this machine would not fit (`mpipd run` "
+                     "refuses it without --force-size; spread the ranks over nodes)")
+    out.append(line)
+    from .output.writer import n_frames
+    rf = run_file_bytes(scene, int(table.n_points))
+    out.append(f"  run file: {gb(rf)} allocated before step 1 "
+               f"({n_frames(scene.time.n_steps, scene.output.every)} frame(s) x "
+               f"{len(scene.output.fields)} field(s) x {table.n_points} points, plus geometry "
+               "and probes; `mpipd run` refuses it, without --force-size, where it would take "
+               "more than 90 % of the file system's free space)")
     return "\n".join(out)
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import socket
 import sys
 from pathlib import Path
 
@@ -51,6 +52,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="override a scene value, e.g. --set time.steps=100")
     r.add_argument("--out", default=None, help="output directory (default runs/<scene name>)")
     r.add_argument("--overwrite", action="store_true", help="replace an existing run.h5")
+    r.add_argument("--force-size", action="store_true",
+                   help="run even if the run file's size or the model's memory, estimated "
+                        "before anything is built, exceeds the free disk space or memory")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
     c = sub.add_parser("check", help="validate a scene and report sizes and the stable dt")
     c.add_argument("scene")
@@ -198,6 +202,8 @@ def _run(args, team, signals=None) -> int:
         if scene.time.dt > dt_stable and not args.force:
             raise UsageError(f"time.dt = {scene.time.dt:.4e} s exceeds the stable estimate "
                              f"{dt_stable:.4e} s (see `mpipd check`); use --force to run anyway")
+        hosts = team.gather((socket.gethostname(), _mem_available()))
+        _on_root(team, _check_sizes, scene, team.size, hosts, out, args)
         sim = Simulation(scene, team)
         if args.restart:
             ck.restore(sim, args.restart)
@@ -243,6 +249,66 @@ def _run(args, team, signals=None) -> int:
     finally:
         if lock is not None:
             lock.release()
+
+
+def _mem_available():
+    from .check import mem_available
+    return mem_available()
+
+
+def _free_bytes(out: Path) -> int:
+    """Free bytes (for this user) on the file system that holds ``out`` or, if it
+    does not exist yet, its nearest existing parent."""
+    p = out.resolve()
+    while not p.exists():
+        p = p.parent
+    st = os.statvfs(p)
+    return st.f_bavail * st.f_frsize
+
+
+#: the share of the free space a new run file may take (the rest is left to the
+#: checkpoints, the log and whatever else shares the file system)
+FREE_SHARE = 0.9
+
+
+def _check_sizes(scene, ranks, hosts, out: Path, args):
+    """Refuse (UsageError: one line with the numbers and --force-size) a run whose
+    run file, as allocated before step 1, exceeds the free space where it goes, or
+    whose model (mpipd.check's memory model) exceeds the memory available on a host
+    of the job -- before anything is built or written.  A restart needs only what
+    its run file grows by; --overwrite counts the old run's files as free."""
+    from .check import gb, sizes
+    from .output import rundir
+    from .output.writer import n_frames
+    sz = sizes(scene, ranks)
+    h5 = out / rundir.RUN_FILE
+    need, free = sz.run_file, _free_bytes(out)
+    if args.restart and h5.exists():
+        need = max(0, need - h5.stat().st_size)
+    elif args.overwrite and out.is_dir():
+        free += sum((out / n).stat().st_size for n in (rundir.RUN_FILE, "run.xdmf",
+                                                       *rundir.OLD_RUN_FILES)
+                    if (out / n).is_file())
+    frames = n_frames(scene.time.n_steps, scene.output.every)
+    if need > FREE_SHARE * free and not args.force_size:
+        raise UsageError(f"the run file {h5} needs about {gb(need)} ({frames} frame(s) of "
+                         f"{len(scene.output.fields)} field(s) x {sz.points} points"
+                         + (f", {len(scene.probes)} probe(s) x {scene.time.n_steps + 1} steps"
+                            if scene.probes else "") + "), allocated before step 1; "
+                         f"{gb(free)} free there, and a run may take at most "
+                         f"{FREE_SHARE:.0%} of it (time.t_end, time.steps or output.every "
+                         "mistyped?); --force-size to run anyway")
+    per_host: dict = {}
+    for r, (host, avail) in enumerate(hosts):
+        used, have = per_host.get(host, (0, avail))
+        per_host[host] = (used + sz.memory[r], have)
+    for host, (used, have) in per_host.items():
+        if have is not None and used > have and not args.force_size:
+            raise UsageError(f"the model needs about {gb(used)} on host {host} "
+                             f"({gb(max(sz.memory))} on its largest rank of {ranks}, "
+                             f"{sz.points} points, {sz.bonds} bonds; `mpipd check`), "
+                             f"{gb(have)} available there: use more nodes or a coarser dx; "
+                             "--force-size to run anyway")
 
 
 def _shown(text: str, overrides) -> str:

@@ -260,3 +260,78 @@ def test_two_runs_started_at_once_into_one_folder(tmp_path):
         assert int(f.attrs["frames_written"]) == f["time"].shape[0] == 4
         assert np.isfinite(f["fields/u"][...]).all()
     assert not (out / "run.lock").exists()
+
+
+# ----------------------------------------------------------------- data loss 4: sizes first
+
+@pytest.fixture
+def small_fs(tmp_path):
+    """A 20 MB tmpfs (needs root; skipped elsewhere)."""
+    import os
+    p = tmp_path / "fs"
+    p.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=20m", "tmpfs", str(p)],
+                      capture_output=True).returncode != 0:
+        if os.geteuid() == 0:
+            pytest.fail("mount -t tmpfs failed as root")
+        pytest.skip("mounting a tmpfs needs root")
+    yield p
+    subprocess.run(["umount", "-l", str(p)], capture_output=True)
+
+
+@pytest.mark.parametrize("setting,needles", [
+    ("time.t_end=1.2e-3", ("needs about 0.09", "301 frame(s) of 2 field(s) x 6144 points",
+                           "--force-size")),
+    ("time.steps=999999999999999999", ("needs about", "--force-size")),
+    ("time.t_end=1e30", ("needs about", "--force-size")),
+    ("time.steps=99999999999999999999", ("time.steps: must be below 2^63",)),
+    ("output.every=99999999999999999999", ("output.every: must be below 2^63",)),
+    ("parts.0.jitter_seed=9999999999999999999", ("parts[0].jitter_seed: must be below 2^63",)),
+])
+def test_too_big_for_the_disk_is_refused_before_overwrite_deletes(small_fs, setting, needles):
+    """An existing run on a 20 MB file system and --overwrite with a run file of
+    88 MB (or a typo'd length): exit 2, one line with the numbers; the old run
+    (its log and checkpoint included) byte for byte unchanged."""
+    out = small_fs / "o"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    before = md5s(out)
+    assert "checkpoint.h5" in before and "run.log" in before
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--overwrite",
+                   "--set", setting])
+    one_error(res, *needles)
+    assert md5s(out) == before
+
+
+def test_restart_that_would_outgrow_the_disk_is_refused(small_fs):
+    out = small_fs / "o"
+    assert run_cli(["run", "elastic_wave", "--out", str(out), *SMALL,
+                    "--stop-after", "20"]).returncode == 0
+    before = md5s(out)
+    res = run_cli(["run", "--restart", str(out / "checkpoint.h5"), "--set", "time.t_end=1.2e-3"])
+    one_error(res, "needs about", "--force-size")
+    assert md5s(out) == before
+
+
+def test_model_larger_than_memory_is_refused(tmp_path):
+    """The memory check, in-process (no run is started): a host with 1 MB available."""
+    import argparse
+
+    from mpipd.cli import UsageError, _check_sizes
+    from mpipd.input import scene as sc
+    scene, _ = sc.load("elastic_wave", ["parts.0.dx=0.002", "time.steps=10"])
+    args = argparse.Namespace(restart=None, overwrite=False, force_size=False)
+    with pytest.raises(UsageError, match=r"the model needs about .* on host h .* 0\.001 GB "
+                                         r"available there.*--force-size"):
+        _check_sizes(scene, 2, [("h", 10**6), ("h", 10**6)], tmp_path / "o", args)
+    _check_sizes(scene, 2, [("h", 10**12), ("g", 10**12)], tmp_path / "o", args)
+    _check_sizes(scene, 2, [("h", 10**6), ("h", 10**6)], tmp_path / "o",
+                 argparse.Namespace(restart=None, overwrite=False, force_size=True))
+    assert not (tmp_path / "o").exists()
+
+
+def test_check_reports_memory_and_run_file_size():
+    res = run_cli(["check", "elastic_wave", *SMALL[:-1]])
+    assert res.returncode == 0, res.stderr
+    assert "memory: the model's arrays" in res.stdout and "available" in res.stdout
+    assert "run file: 0.00" in res.stdout and "4 frame(s) x 2 field(s) x 6144 points" in res.stdout

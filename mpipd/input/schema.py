@@ -81,6 +81,10 @@ def _tname(v) -> str:
             int: "integer", float: "float"}.get(type(v), type(v).__name__)
 
 
+#: integers a scene may hold: int64's range (HDF5 attributes, NumPy seeds)
+INT_LIMIT = 2 ** 63
+
+
 def _coerce(tp, value, path):
     """Check/convert one TOML value against a type annotation."""
     origin = typing.get_origin(tp)
@@ -120,6 +124,8 @@ def _coerce(tp, value, path):
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
             fail(path, f"expected an integer, got {_tname(value)} {value!r}")
+        if not -INT_LIMIT <= value < INT_LIMIT:        # run files and seeds hold int64
+            fail(path, f"must be below 2^63 in size (got {value})")
         return value
     if tp is bool:
         if not isinstance(value, bool):
