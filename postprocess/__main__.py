@@ -109,8 +109,42 @@ def section(run: Run, comm, field: str, frame: int, z: float | None):
     return xs, ys, vs, zlev
 
 
+def frame_index(run: Run, frame: int) -> int:
+    """``--frame`` as an index into the written frames (negative from the end);
+    one outside them is refused."""
+    if not -run.frames <= frame < run.frames:
+        raise ValueError(f"--frame {frame}: the run file holds {run.frames} frame(s) "
+                         f"(0..{run.frames - 1}, or -{run.frames}..-1 from the end)")
+    return frame % run.frames
+
+
+def check_z(run: Run, comm, z: float | None) -> None:
+    """A section height more than a lattice spacing beyond the body is refused."""
+    if z is None:
+        return
+    x = run.geometry("x")
+    zmin = run.min(x[:, 2].min() if len(x) else np.inf)
+    zmax = run.max(x[:, 2].max() if len(x) else -np.inf)
+    vol = run.geometry("volume")
+    dx = float(np.cbrt(run.max(vol.max() if len(vol) else 0.0)))
+    if not zmin - dx <= z <= zmax + dx:
+        raise ValueError(f"--z {z:g} m is outside the body (its points span z = {zmin:g}.."
+                         f"{zmax:g} m)")
+
+
+def check_png_out(out: str) -> None:
+    from pathlib import Path
+    p = Path(out)
+    if p.is_dir():
+        raise ValueError(f"--out {out} is a directory (give the PNG's path)")
+    if not p.resolve().parent.is_dir():
+        raise ValueError(f"--out {out}: no directory {p.resolve().parent}")
+
+
 def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[str]:
-    k = frame % run.frames
+    k = frame_index(run, frame)
+    check_z(run, comm, z)
+    check_png_out(out)
     sec = section(run, comm, field, k, z)
     if comm.Get_rank() != 0:
         return []
@@ -175,6 +209,9 @@ def main(argv=None) -> int:
                          "(default: docs/validation -> docs/validation.md)")
     va.add_argument("--notes", default=None, help="hand-written diagnoses (markdown), inserted "
                     "verbatim under 'Diagnoses'")
+    va.add_argument("--base", default=None, metavar="CASE",
+                    help="the row the record's Summary table shows (a run folder's name; "
+                         "default: the first run)")
     va.add_argument("--check", action="store_true",
                     help="only check that every input exists (exit 2 naming what is missing)")
     fg = sub.add_parser("fragments", help="fragments of a frame and the size distribution")
@@ -248,12 +285,15 @@ def _analysis_cmd(args, comm) -> list[str]:
     if args.cmd == "report":
         from .report import make_report
         out = args.out or str(Path(args.run).resolve().parent / "report")
+        if Path(out).exists() and not Path(out).is_dir():
+            raise UsageError(f"--out {out} exists and is not a directory")
         times = [float(t) for t in args.times.split(",")] if args.times else None
         return make_report(args.run, out, comm, times)
     if args.cmd == "validate":
         from .validation import InputError, make_validation
         try:
-            return make_validation(args.runs, args.out, comm, args.notes, args.argv, args.check)
+            return make_validation(args.runs, args.out, comm, args.notes, args.argv, args.check,
+                                   args.base)
         except InputError as e:
             raise UsageError(str(e)) from None
     from .compare import make_compare

@@ -335,3 +335,54 @@ def test_check_reports_memory_and_run_file_size():
     assert res.returncode == 0, res.stderr
     assert "memory: the model's arrays" in res.stdout and "available" in res.stdout
     assert "run file: 0.00" in res.stdout and "4 frame(s) x 2 field(s) x 6144 points" in res.stdout
+
+
+# ----------------------------------------------------------------- postprocess (items 8, 9)
+
+@pytest.fixture(scope="module")
+def three_frames(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pp") / "r"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set", "time.steps=40",
+                   "--set", 'output.fields=["u","stress_work"]'])
+    assert res.returncode == 0, res.stdout + res.stderr
+    return out
+
+
+def postprocess(*args):
+    return subprocess.run([sys.executable, "-m", "postprocess", *args], capture_output=True,
+                          text=True, cwd=ROOT, timeout=120)
+
+
+@pytest.mark.parametrize("extra,needle", [
+    (["--frame", "99"], "--frame 99: the run file holds 3 frame(s)"),
+    (["--frame", "-4"], "--frame -4: the run file holds 3 frame(s)"),
+    (["--z", "5"], "--z 5 m is outside the body"),
+    (["--z", "-0.01"], "--z -0.01 m is outside the body"),
+    (["--out", "/nonexistent/dir/x.png"], "no directory /nonexistent/dir"),
+])
+def test_fracture_refuses_what_it_cannot_plot(three_frames, tmp_path, extra, needle):
+    before = md5s(three_frames)
+    res = postprocess("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
+                      *(extra if "--out" in extra else [*extra, "--out", str(tmp_path / "f.png")]))
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "Traceback" not in res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("postprocess: error: ") and needle in lines[0], \
+        res.stderr
+    assert not (tmp_path / "f.png").exists() and md5s(three_frames) == before
+
+
+def test_fracture_in_range_still_plots(three_frames, tmp_path):
+    res = postprocess("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
+                      "--frame", "-3", "--z", "0.008", "--out", str(tmp_path / "f.png"))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (tmp_path / "f.png").stat().st_size > 0
+
+
+def test_report_out_on_a_file_is_one_line(three_frames, tmp_path):
+    f = tmp_path / "file"
+    f.write_text("keep")
+    res = postprocess("report", str(three_frames / "run.h5"), "--out", str(f))
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "Traceback" not in res.stderr and "exists and is not a directory" in res.stderr
+    assert f.read_text() == "keep"
