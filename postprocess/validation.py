@@ -300,6 +300,41 @@ def _throughput(segments, steps=None) -> str:
             + (f" over the recorded steps{gaps}" if gaps else ""))
 
 
+def summary_table(runs, base: str | None) -> list[str]:
+    """The record's first table: one row per judged target (kind "range" or
+    "consistency") of the base row, ``quantity | experiment | paper | base row | verdict``,
+    the values and verdicts read from its report.json as in :func:`targets_table`.
+    ``base``: the case name of the base row (default: the first run)."""
+    if not runs:
+        return []
+    r = next((r for r in runs if r["case"] == base), None) if base else runs[0]
+    if r is None:
+        raise InputError(f"--base {base}: no such row (the rows: "
+                         + ", ".join(x["case"] for x in runs) + ")")
+    L = ["## Summary", "",
+         f"The base row `{r['case']}` against the experiment and the paper, one row per "
+         "judged quantity (the full table of every row is under Targets).", "",
+         f"| quantity | experiment | paper | {r['case']} | verdict |", "|---|---|---|---|---|"]
+    n = {"within": 0, "outside": 0, "other": 0}
+    for t in TARGETS:
+        if t.kind == "information":
+            continue
+        got = r["judged"].get(t.key)
+        if got is None:
+            value, now, shown = "—", "not in report.json", "not in report.json"
+        else:
+            row, now, stored = got
+            value, shown = value_cell(row, now), verdict_cell(now, stored)
+        n["within" if now.startswith("within") else
+          "outside" if now.startswith("outside") else "other"] += 1
+        unit = f" ({t.unit})" if t.unit and t.unit != "—" else ""
+        L.append(f"| {_cell(t.label + unit)} | {_cell(t.experiment)} | {_cell(t.paper)} | "
+                 f"{value} | {shown} |")
+    L += ["", f"{n['within']} within, {n['outside']} outside, {n['other']} without a verdict "
+          "(not available or not in report.json).", ""]
+    return L
+
+
 def targets_table(runs) -> list[str]:
     head = "| quantity | unit | paper | experiment | range used | " + " | ".join(
         f"{r['case']} | {r['case']} verdict" for r in runs) + " |"
@@ -473,13 +508,14 @@ def run_section(k, r) -> list[str]:
     return L
 
 
-def render(runs, command, code_commit, notes) -> str:
+def render(runs, command, code_commit, notes, base=None) -> str:
     L = ["# Validation record", "",
          f"Made by `{command}` (postprocess at commit {code_commit}); `make validate` "
          "re-creates it from the run files in `VALIDATE_RUNS` (mk/validate.mk).  Every number "
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
-    L += (provenance(runs) + coverage_table(runs) + targets_table(runs) + threshold_table(runs)
+    L += (summary_table(runs, base) + provenance(runs) + coverage_table(runs) + targets_table(runs)
+          + threshold_table(runs)
           + bias_table(runs) + orientation_table(runs))
     for k, r in enumerate(runs, 1):
         L += run_section(k, r)
@@ -522,7 +558,10 @@ def code_commit() -> str:
     return head[:12] + (" with uncommitted changes in postprocess/" if dirty else "")
 
 
-def make_validation(args, out, comm, notes=None, argv=None, check_only=False) -> list[str]:
+def make_validation(args, out, comm, notes=None, argv=None, check_only=False,
+                    base=None) -> list[str]:
+    """The record (module docstring); ``base``: the case name of the row the Summary
+    shows (default: the first input)."""
     inputs = resolve(args)
     notes_text = None
     if notes is not None:
@@ -553,6 +592,8 @@ def make_validation(args, out, comm, notes=None, argv=None, check_only=False) ->
                      "md_dir": f"{out.name}/{case}", "dir": out / case,
                      "figures": {n: doc["figures"][n] for n, _ in KEY_FIGURES
                                  if doc["figures"].get(n)}})
+    if base is not None and base not in taken:         # before anything is written
+        raise InputError(f"--base {base}: no such row (the rows: {', '.join(sorted(taken))})")
     for r in runs:
         d = r["dir"]
         if d.is_dir():                      # only what this command writes there
@@ -565,7 +606,7 @@ def make_validation(args, out, comm, notes=None, argv=None, check_only=False) ->
         r["figures"] = {n: Path(f).name for n, f in r["figures"].items()}
     command = "python -m postprocess " + shlex.join(argv if argv is not None else
                                                     ["validate", "--out", str(out), *args])
-    md.write_text(render(runs, command, code_commit(), notes_text))
+    md.write_text(render(runs, command, code_commit(), notes_text, base))
     stale = sorted(p.name for p in out.iterdir() if p.is_dir() and p.name not in taken)
     lines.append(f"wrote {md} and {out}/ ({', '.join(r['case'] for r in runs)})")
     if stale:

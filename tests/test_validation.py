@@ -191,6 +191,37 @@ def test_record(two_reports, capsys):
     assert "not made: the run has no peak_speed field" in md
 
 
+def test_summary_table_comes_first_with_the_base_row(two_reports, capsys):
+    """The record opens with one table, quantity | experiment | paper | base | verdict,
+    a row per judged target (information rows left out) of the row --base names; a
+    --base that names no row is refused before anything is written."""
+    tmp, a, b, good, bad = two_reports
+    out = tmp / "docs" / "validation"
+    assert main(["validate", "--out", str(out), str(a), str(b), "--base", "beta"]) == 0
+    md = (tmp / "docs" / "validation.md").read_text()
+    assert md.index("## Summary") < md.index("## Provenance") < md.index("## Targets")
+    rows = table(md, "## Summary")
+    assert rows[0] == ["quantity", "experiment", "paper", "beta", "verdict"]
+    judged_t = [t for t in TARGETS if t.kind != "information"]
+    assert len(rows) - 2 == len(judged_t)
+    for t, row in zip(judged_t, rows[2:]):
+        assert row[0].startswith(t.label) and row[1] == t.experiment and row[2] == t.paper
+        if t.key == "peak_sigma_rr_G":
+            assert row[3] == "—" and row[4] == "not available: no probe G"
+        else:
+            assert row[4] == "**outside**", t.key
+    n_out = sum(1 for t in judged_t if t.key != "peak_sigma_rr_G")
+    assert f"0 within, {n_out} outside, 1 without a verdict" in md
+    # the default is the first run, all within
+    assert main(["validate", "--out", str(out), str(a), str(b)]) == 0
+    rows = table((tmp / "docs" / "validation.md").read_text(), "## Summary")
+    assert rows[0][3] == "alpha" and all(r[4] == "**within**" for r in rows[2:])
+    before = (tmp / "docs" / "validation.md").read_bytes()
+    assert main(["validate", "--out", str(out), str(a), str(b), "--base", "gamma"]) == 2
+    assert "--base gamma: no such row" in capsys.readouterr().err
+    assert (tmp / "docs" / "validation.md").read_bytes() == before
+
+
 def test_changed_verdict_is_flagged(tmp_path, capsys):
     """A verdict stored in report.json that targets.verdict no longer gives (the bands
     changed since the report) is shown beside the current one."""
