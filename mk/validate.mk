@@ -85,6 +85,9 @@
 #   case 6 at the physics of rerun2 and case5_rerun, for its ring arcs at every frame, notes §47):
 #   mpirun -n 2 mpipd run blast_paper:case6 --set output.every=200 --set output.checkpoint_every=500
 #   --out runs/blast_paper_case6_rerun
+# blast_paper_eq35 (04370ba, the base scene at the paper's model: Eq. 35's pressure, the gas on the copper only,
+#   the spring-fallback fix; notes §48; the Summary's row): mpirun -n 2 mpipd run blast_paper --set output.every=200
+#   --set output.checkpoint_every=500 --out runs/blast_paper_eq35
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -96,15 +99,18 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
     runs/blast_paper_case5_rerun/run.h5 runs/blast_paper_rerun2/run.h5 runs/blast_paper_case6_rerun/run.h5 \
-    runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5
+    runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5 runs/blast_paper_eq35/run.h5
 VALIDATE_OUT ?= docs/validation
 VALIDATE_NOTES ?= docs/validation_notes.md
 VALIDATE_RANKS ?= 2
+# the row of the record's Summary table: the base scene at the paper's model (issue 60)
+VALIDATE_BASE ?= blast_paper_eq35
 
 validate: install
 	@$(PY) -m postprocess validate --check $(VALIDATE_RUNS)
 	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
-	    $(VALIDATE_RUNS) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES))
+	    $(VALIDATE_RUNS) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES)) \
+	    $(if $(filter $(VALIDATE_BASE),$(notdir $(patsubst %/run.h5,%,$(VALIDATE_RUNS)))),--base $(VALIDATE_BASE))
 
 # `make diagnoses`: the cheaper runs behind docs/validation_notes.md's diagnoses, each
 # changing one thing, and their tables under docs/diagnoses/ (a run file that exists
@@ -207,4 +213,5 @@ record: install
 	@mkdir -p runs
 	@$(PY) scripts/record_rows.py --rows runs/rows $(VALIDATE_RUNS) > runs/record_inputs.txt
 	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
-	    $$(cat runs/record_inputs.txt) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES))
+	    $$(cat runs/record_inputs.txt) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES)) \
+	    $(if $(filter $(VALIDATE_BASE),$(notdir $(patsubst %/run.h5,%,$(VALIDATE_RUNS)))),--base $(VALIDATE_BASE))
