@@ -19,6 +19,21 @@ BOUNDARIES = Registry("boundary condition", "kind")
 LOADS = Registry("load", "kind")
 
 AXES = {"x": 0, "y": 1, "z": 2}
+#: the speed of light (m/s): an initial speed at or above it is refused as input
+#: (nothing moves so fast; 1e200 m/s overflowed the kinetic energy to inf and
+#: surfaced as an instability, "compare dt", from inside the model's construction)
+C_LIGHT = 299_792_458.0
+
+
+def below_light(obj, path, name):
+    """Refuse an initial velocity (vector) or speed whose magnitude is not below
+    :data:`C_LIGHT`."""
+    value = np.atleast_1d(np.asarray(getattr(obj, name), dtype=float))
+    top = float(np.max(np.abs(value))) if np.all(np.isfinite(value)) else np.inf
+    size = top * float(np.sqrt(np.sum((value / top) ** 2))) if 0.0 < top < np.inf else top
+    if not size < C_LIGHT:
+        fail(join(path, name), f"an initial speed of {size:.4g} m/s is not below the speed "
+             f"of light ({C_LIGHT:.4g} m/s)")
 
 
 @dataclass(frozen=True)
@@ -52,6 +67,7 @@ class VelocityPulse:
         if self.axis not in AXES:
             fail(join(path, "axis"), f"must be one of x, y, z (got {self.axis!r})")
         positive(self, path, "half_width")
+        below_light(self, path, "velocity")
 
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         s = x[:, AXES[self.axis]] - self.center
@@ -66,6 +82,9 @@ class UniformVelocity:
     """v = ``velocity`` for every point inside ``region``."""
     region: Region
     velocity: tuple[float, float, float]
+
+    def check(self, path):
+        below_light(self, path, "velocity")
 
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         v[self.region.contains(x)] += np.asarray(self.velocity)
@@ -82,6 +101,7 @@ class GaussianVelocity:
 
     def check(self, path):
         positive(self, path, "sigma")
+        below_light(self, path, "velocity")
 
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         s2 = np.sum((x - np.asarray(self.center)) ** 2, axis=1)
@@ -103,6 +123,7 @@ class RadialVelocity:
         non_negative(self, path, "r_inner")
         if not self.r_outer > self.r_inner:
             fail(join(path, "r_outer"), "must exceed r_inner")
+        below_light(self, path, "speed")
 
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         dx = x[:, 0] - self.center[0]

@@ -15,6 +15,11 @@ that owns it records, every step,
     t, sigma_rr, v_r            radial stress and velocity about the axis through ``center``
     p                           pressure -tr(sigma)/3 (compression positive)
     s                           von Mises equivalent stress
+                                (a point of the explosive gas: its stress is the JWL
+                                pressure's, sigma = -p I, with p the gas model's, as
+                                in ``/fields/pressure`` (mpipd.model.gas: the EOS
+                                pressure, without the bulk viscosity q), so
+                                sigma_rr = -p and s = 0)
     strength                    JH2 yield strength sigma_y at the point's p*, edot*, D
                                 (NaN for other materials)
     t_state                     the time of the state its stress was taken at: t in
@@ -37,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..input.schema import fail
+from ..kernels.layout import GD_P
 from ..model.multirate import steps_since_update
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength", "t_state")
@@ -69,12 +75,14 @@ def part_matches(part: str, name: str) -> bool:
 
 
 class Probes:
-    def __init__(self, probes, scene, points, team, corr, v, mode, klass):
+    def __init__(self, probes, scene, points, team, corr, v, mode, klass, gas=None):
         """``probes``: the scene's; ``corr``: the correspondence model (stress of a
         point, material groups); ``v``, ``mode`` and ``klass``: the State's velocities,
-        failure flags and step classes.  Collective (the nearest point is found over
-        all ranks)."""
+        failure flags and step classes; ``gas``: the gas model (mpipd.model.gas.Gas),
+        if the scene has one (the pressure of a gas point).  Collective (the nearest
+        point is found over all ranks)."""
         self.probes = list(probes)
+        self.gas = gas
         self.team, self.corr, self.v, self.mode = team, corr, v, mode
         self.klass, self.dt = klass, scene.time.dt
         self.points = points
@@ -145,15 +153,18 @@ class Probes:
         """Record step ``step`` (time ``t``) at every probe this rank owns."""
         for k, i in self.mine:
             pr = self.probes[k]
-            s = self.corr.cauchy_stress_of(i)
+            s = self._stress(i)
             dx, dy = self.points.x[i, 0] - pr.center[0], self.points.x[i, 1] - pr.center[1]
             r = math.hypot(dx, dy) or 1.0
             c, sn = dx / r, dy / r
             srr = s[0] * c * c + s[1] * sn * sn + 2 * s[5] * c * sn
             vr = self.v[i, 0] * c + self.v[i, 1] * sn
-            p = -(s[0] + s[1] + s[2]) / 3.0
-            dev = np.array([s[0] + p, s[1] + p, s[2] + p])
-            seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
+            if self._is_gas(i):         # sigma = -p I: its p as it is, sigma_rr = -p, s = 0
+                p, srr, seq = -s[0], s[0], 0.0
+            else:
+                p = -(s[0] + s[1] + s[2]) / 3.0
+                dev = np.array([s[0] + p, s[1] + p, s[2] + p])
+                seq = math.sqrt(1.5 * (dev @ dev + 2 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
             if not self.rows[k]:
                 self.start[k] = step
             lag = steps_since_update(step, int(self.klass[i]))
@@ -161,6 +172,17 @@ class Probes:
             self.rows[k].append(row)
             pk = self.peak[k]
             pk[0], pk[1], pk[2] = min(pk[0], srr), max(pk[1], abs(vr)), max(pk[2], p)
+
+    def _is_gas(self, i) -> bool:
+        return self.gas is not None and bool(self.gas.is_gas[i])
+
+    def _stress(self, i) -> np.ndarray:
+        """Cauchy stress of owned point i, Voigt order: the correspondence model's,
+        or, at a point of the gas, -p I with the gas model's pressure."""
+        if self._is_gas(i):
+            p = float(self.gas.gd[i, GD_P])
+            return np.array([-p, -p, -p, 0.0, 0.0, 0.0])
+        return self.corr.cauchy_stress_of(i)
 
     def restore_peaks(self, peaks: dict):
         """Continue the running peaks of a checkpoint (name -> peaks(), as written)."""
