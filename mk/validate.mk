@@ -215,3 +215,31 @@ record: install
 	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
 	    $$(cat runs/record_inputs.txt) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES)) \
 	    $(if $(filter $(VALIDATE_BASE),$(notdir $(patsubst %/run.h5,%,$(VALIDATE_RUNS)))),--base $(VALIDATE_BASE))
+
+# `make effective-load`: the slab of blast_paper (blast_paper:slab) at the base's model,
+# with Eq. 25's pressure, and with the gas pressure scaled by 0.5 and 0.25 (the cases
+# load0.5 / load0.25 on the slab), each reported, then the table
+# docs/effective_load_slab.md (issue 60, item 7; about 30 minutes on 2 cores alone)
+EL_RUNS := eq35 eos pf0.5 pf0.25
+EL_SET_eq35 :=
+EL_SET_eos := --set 'materials.granite.pressure="eos"'
+EL_SET_pf0.5 := --set materials.explosive.pressure_factor=0.5
+EL_SET_pf0.25 := --set materials.explosive.pressure_factor=0.25
+.PHONY: effective-load
+effective-load: install
+	$(foreach r,$(EL_RUNS),$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_paper:slab --out runs/slab_$(r) \
+	    --overwrite --quiet --set output.every=100 $(EL_SET_$(r)) && \
+	    $(MPIRUN) -n 2 $(PY) -m postprocess report runs/slab_$(r)/run.h5 --out runs/slab_$(r)/report > /dev/null &&) true
+	$(PY) benchmarks/multirate_compare.py --out docs/effective_load_slab.md \
+	    --title "blast_paper:slab at the base's model (eq35), with Eq. 25's pressure (eos) and with the gas pressure x 0.5 and x 0.25; \`make effective-load\`" \
+	    $(foreach r,$(EL_RUNS),$(r)=runs/slab_$(r))
+
+# `make paper-model`: the base scene at the paper's model (row blast_paper_eq35: Eq. 35's
+# pressure, the gas on the copper only, the spring-fallback fix; issue 60) beside the
+# previous model's last base row (blast_paper_rerun2), from the rows' report.json
+PM_BASE ?= docs/validation/blast_paper_rerun2
+PM_ROWS ?= $(wildcard docs/validation/blast_paper_eq35)
+PM_OUT ?= docs/paper_model_blast_paper.md
+.PHONY: paper-model
+paper-model: install
+	$(call compare_rows,$(PM_OUT),The base scene at the paper's model (eq35) beside the previous model's base row (previous); \`make paper-model\`,previous=$(PM_BASE),$(PM_ROWS),blast_paper_eq35 row)
