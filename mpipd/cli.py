@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shlex
 import socket
 import sys
 from pathlib import Path
@@ -178,6 +179,13 @@ def _run(args, team, signals=None) -> int:
             out = Path(args.out) if args.out else Path("runs") / scene.name
         h5 = out / rundir.RUN_FILE
         n_steps = scene.time.n_steps
+        if args.stop_after is not None and args.stop_after >= n_steps:
+            raise UsageError(f"--stop-after {args.stop_after} is not before the run's last step "
+                             f"{n_steps}: the run would end without stopping there (and with "
+                             "no checkpoint unless output.checkpoint_every > 0)")
+        if args.restart and args.stop_after is not None and args.stop_after <= info.step:
+            raise UsageError(f"--stop-after {args.stop_after} is not after the checkpoint's "
+                             f"step {info.step}")
         if args.restart:
             if n_steps < info.step:
                 raise UsageError(f"the run length ({n_steps} steps) ends before the "
@@ -426,7 +434,7 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
         log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; {n_switched} stable-step "
             "switch(es) from the correspondence force in this invocation "
             f"(mpipd.model.correspondence.stable_floor); checkpoint {checkpointer.written}; "
-            f"continue with `mpipd run --restart {checkpointer.written}`")
+            f"continue with `mpipd run --restart {shlex.quote(str(checkpointer.written))}`")
         if over:
             log(f"mpipd: warning: {over}", error=True)
         return 0

@@ -114,3 +114,38 @@ def test_a_radial_speed_of_1e200_is_bad_input(tmp_path):
                    "--quiet"])
     one_error(res, "initial[0].speed", "1e+200 m/s", "speed of light")
     assert not out.exists()
+
+
+# ----------------------------------------------------------------- item 10 (some)
+
+def test_a_utf8_bom_is_no_statement(tmp_path):
+    from mpipd.input.scene import builtin_scenes
+    f = tmp_path / "bom.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + builtin_scenes()["elastic_wave"].read_bytes())
+    res = run_cli(["check", str(f)])
+    assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_a_missing_path_with_a_colon_is_named_as_a_path(tmp_path):
+    missing = str(tmp_path / "no:such.toml")
+    res = run_cli(["check", missing])
+    one_error(res, "no file or built-in scene named", "no:such.toml")
+    one_error(run_cli(["check", "blast_paper:nosuch"]), "no case 'nosuch'")
+
+
+def test_stop_after_beyond_the_end_is_refused(tmp_path):
+    out = tmp_path / "w"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "60"])
+    one_error(res, "--stop-after 60", "last step 60")
+    assert not out.exists()
+
+
+def test_the_restart_hint_is_shell_quoted(tmp_path):
+    import shlex
+    out = tmp_path / "a b"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    ck = str(out / "checkpoint.h5")
+    assert f"`mpipd run --restart {shlex.quote(ck)}`" in res.stdout
+    res = run_cli(["run", "--restart", ck, "--stop-after", "20"])
+    one_error(res, "not after the checkpoint's step 20")

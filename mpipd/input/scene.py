@@ -609,6 +609,8 @@ def expand_case(source: str, overrides=()) -> tuple[str, list[str]]:
     if ":" not in source or Path(source).is_file():
         return source, list(overrides)
     base, name = source.rsplit(":", 1)
+    if base not in builtin_scenes():      # a path with a ':' in it: resolve says what is missing
+        return source, list(overrides)
     known = cases(base)
     if name not in known:
         fail("scene", f"no case {name!r} of {base!r} "
@@ -622,7 +624,7 @@ def load(source: str, overrides=()) -> tuple[Scene, str]:
     source, overrides = expand_case(source, overrides)
     path = resolve(source)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8-sig")     # a UTF-8 BOM is no TOML statement
     except (OSError, UnicodeDecodeError) as e:
         fail(str(source), f"cannot read: {e}")
     return parse(text, str(source), overrides), text
