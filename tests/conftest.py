@@ -66,6 +66,32 @@ def child_env():
     return {k: v for k, v in os.environ.items() if not k.startswith(_LAUNCHER_VARS)}
 
 
+
+#: a 1-2 second elastic_wave run (the CLI tests' small run)
+SMALL = ["--set", "parts.0.dx=0.002", "--set", "time.dt=2e-7", "--set", "time.t_end=1.2e-5",
+         "--set", "output.every=20", "--quiet"]
+
+
+def md5s(folder: Path) -> dict:
+    """md5 of every file in ``folder`` (nothing overwritten: compare before and after)."""
+    import hashlib
+    return {p.name: hashlib.md5(p.read_bytes()).hexdigest()
+            for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def one_error(res, *needles, code=2):
+    """The CLI exited ``code`` with one distinct ``mpipd: error:`` line (the same line
+    from every rank counts once), no traceback, holding every needle; returns it."""
+    assert res.returncode == code, res.stdout + res.stderr
+    assert "Traceback" not in res.stderr, res.stderr
+    lines = {ln for ln in res.stderr.splitlines() if ln.startswith("mpipd")}
+    assert len(lines) == 1, res.stderr
+    line = lines.pop()
+    assert line.startswith("mpipd: error: "), line
+    for n in needles:
+        assert n in line, line
+    return line
+
 def run_cli(args, ranks=None, timeout=300, cwd=None):
     """Run ``mpipd ARGS`` (under ``mpirun -n ranks`` if given); returns CompletedProcess."""
     cmd = [str(BIN / "mpipd"), *args]

@@ -3,7 +3,6 @@
 A restart of a finished run writes nothing; a restart never rewrites the frame
 counter downwards, never drops a frame it does not write again, and refuses
 changed physics or output fields (exit 2, one line, every file unchanged)."""
-import hashlib
 import json
 import shutil
 import subprocess
@@ -13,27 +12,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
-
-SMALL = ["--set", "parts.0.dx=0.002", "--set", "time.dt=2e-7", "--set", "time.t_end=1.2e-5",
-         "--set", "output.every=20", "--quiet"]
-
-
-def md5s(folder: Path) -> dict:
-    return {p.name: hashlib.md5(p.read_bytes()).hexdigest()
-            for p in sorted(folder.iterdir()) if p.is_file()}
-
-
-def one_error(res, *needles, code=2):
-    assert res.returncode == code, res.stdout + res.stderr
-    assert "Traceback" not in res.stderr, res.stderr
-    lines = {ln for ln in res.stderr.splitlines() if ln.startswith("mpipd")}
-    assert len(lines) == 1, res.stderr
-    line = lines.pop()
-    assert line.startswith("mpipd: error: "), line
-    for n in needles:
-        assert n in line, line
-    return line
+from conftest import ROOT, SMALL, md5s, one_error, run_cli
 
 
 def runstate(out: Path) -> str:

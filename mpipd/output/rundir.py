@@ -323,6 +323,11 @@ class RunLock:
             return "its lock file names no holder yet"
 
     def _undo(self):
+        self.release(remove_dir=True)
+
+    def release(self, remove_dir: bool = False):
+        """Unlink the lock file and drop the lock; ``remove_dir``: also remove the
+        folder if this run made it and it is empty (a run refused before writing)."""
         if self.fd is not None:
             try:
                 os.unlink(self.path)
@@ -330,23 +335,6 @@ class RunLock:
                 pass
             os.close(self.fd)
             self.fd = None
-        if self.made_dir:
-            try:
-                self.path.parent.rmdir()
-            except OSError:
-                pass
-
-    def release(self, remove_dir: bool = False):
-        """Unlink the lock file and drop the lock; ``remove_dir``: also remove the
-        folder if this run made it and it is empty (a run refused before writing)."""
-        if self.fd is None:
-            return
-        try:
-            os.unlink(self.path)
-        except OSError:
-            pass
-        os.close(self.fd)
-        self.fd = None
         if remove_dir and self.made_dir:
             try:
                 self.path.parent.rmdir()
