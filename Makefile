@@ -50,4 +50,4 @@ clean:
 	rm -rf runs .pytest_cache
 
 # further targets (verify, jobs-test, ...) live in mk/*.mk, one file a topic
--include mk/*.mk
+-include mk/*.mk studies/*.mk

@@ -1,6 +1,6 @@
 """README's table of `make bench` figures, made from the output of one `make bench`:
 
-    python benchmarks/bench_table.py docs/bench_runs/make_bench_<commit>.log
+    python benchmarks/bench_table.py studies/bench_logs/make_bench_<commit>.log
 
 reads its ``bench <case> ranks=N key=value ...`` lines (benchmarks/case.py) and the
 LAMMPS peer's ``peer lammps ...`` lines (benchmarks/run.py) and prints the markdown

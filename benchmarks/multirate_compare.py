@@ -4,7 +4,7 @@
 
 Each RUN_DIR holds ``run.h5`` and, for the target rows, ``report/report.json``
 (``python -m postprocess report``; without it the table has the run rows only), or
-only a ``report.json`` (a run whose file is elsewhere: ``docs/validation/<case>/``).
+only a ``report.json`` (a run whose file is elsewhere: ``studies/validation/record/<case>/``).
 The first run is the reference.  The table gives, for every run:
 
 * its commit, ranks and loop wall time (run.h5 ``segments``);
@@ -83,7 +83,7 @@ def lattice_rows(report: dict) -> list[tuple[str, str, object]]:
 
 def read_report(path: Path) -> dict:
     """The same rows from a report.json alone (a run whose run file is not on this
-    machine, e.g. docs/validation/<case>/report.json): its ``run`` block, failure
+    machine, e.g. studies/validation/record/<case>/report.json): its ``run`` block, failure
     modes and ledger."""
     j = json.loads(path.read_text())
     run, fm = j["run"], j["failure_modes"]

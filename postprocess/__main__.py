@@ -204,9 +204,9 @@ def main(argv=None) -> int:
     va.add_argument("runs", nargs="+", metavar="RUNDIR_OR_REPORT",
                     help="a report directory (report.json + figures), a run folder or run.h5 "
                          "(reported first, into report/ beside the run file)")
-    va.add_argument("--out", default="docs/validation",
+    va.add_argument("--out", default="studies/validation/record",
                     help="directory of the per-run files; the record is OUT.md beside it "
-                         "(default: docs/validation -> docs/validation.md)")
+                         "(default: studies/validation/record -> studies/validation/record.md)")
     va.add_argument("--notes", default=None, help="hand-written diagnoses (markdown), inserted "
                     "verbatim under 'Diagnoses'")
     va.add_argument("--base", default=None, metavar="CASE",

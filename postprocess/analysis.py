@@ -92,7 +92,7 @@ def ring_history(sections, model, frames, times, r_min_mm=None) -> dict:
     """Ring arcs frame by frame: :func:`postprocess.crack_orientation.measure` on the
     crack sections (CRACK_SECTIONS) at each of ``frames``, as the report applies it at
     the last frame.  A ring that forms and is later overrun by radial damage (Table 3's
-    case 5, docs/validation_notes.md §45) shows here and not at the last frame.
+    case 5, studies/validation/notes.md §45) shows here and not at the last frame.
 
     Arcs at a radius within ``r_min_mm[section]`` (the report passes each section's
     crushed zone at the last frame) are left out: the wall layer's first circumferential

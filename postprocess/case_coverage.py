@@ -158,7 +158,7 @@ def coverage_table(runs) -> list[str]:
          "or missing from them (*lacks*), and whether the scene file or the case has changed "
          "since that commit.  A case counts when a row ran it at its own settings, on "
          "today's scene, to its t_end.  Only this record's rows count (`make cases` runs "
-         "every case of blast_demo: docs/cases/blast_demo.md).  Read from report.json, the "
+         "every case of blast_demo: studies/cases/blast_demo.md).  Read from report.json, the "
          "scene files and git (postprocess/case_coverage.py).", ""]
     for base in sorted(by_scene):
         known = sc.cases(base)

@@ -301,7 +301,7 @@ def _first_pulse_peak_arrival(pts) -> dict:
     with distance give no speed, as in :func:`_peak_arrival`.  The times are the sampled
     ones of the first-pulse peak (not refined by a parabola as the whole-run peaks' are).
     A far probe's first pulse can run into the next compression in a fracturing run
-    (§38 of docs/validation_notes.md): read the R² and the times, not the speed alone."""
+    (§38 of studies/validation/notes.md): read the R² and the times, not the speed alone."""
     have = [p for p in pts if p.get("t_first_pulse_peak_us") is not None]
     left = {p["name"]: p["first_pulse_peak_MPa"]["not_available"] for p in pts
             if p.get("t_first_pulse_peak_us") is None

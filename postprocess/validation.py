@@ -1,4 +1,4 @@
-"""``python -m postprocess validate --out docs/validation RUN [RUN ...] [--notes NOTES.md]``:
+"""``python -m postprocess validate --out studies/validation/record RUN [RUN ...] [--notes NOTES.md]``:
 a validation record that anyone can re-create from run files (issue 15).
 
 Each RUN is a report directory (``report.json`` and the figures of
@@ -7,7 +7,7 @@ for a run folder or run file the report is made first, by
 :func:`postprocess.report.make_report` (all ranks), into ``report/`` beside the
 run file.  Rank 0 then writes
 
-* ``<out>.md`` (``--out docs/validation`` writes ``docs/validation.md``): the
+* ``<out>.md`` (``--out studies/validation/record`` writes ``studies/validation/record.md``): the
   command that made it; each run's provenance; the named cases of the rows' scenes
   and the rows that ran each (:mod:`postprocess.case_coverage`); one table with a row per target of
   :data:`postprocess.targets.TARGETS` — the paper's and the experiment's value and,
@@ -70,6 +70,16 @@ class Input:
 
 
 # ------------------------------------------------------------------ inputs
+
+def _shown_path(path: str) -> str:
+    """A run file as the record shows it: relative to the repository when inside it
+    (so that no machine path lands in a committed file), else as recorded."""
+    root = Path(__file__).resolve().parents[1]
+    try:
+        return str(Path(path).relative_to(root))
+    except ValueError:
+        return path
+
 def how_to_make(run_file: Path) -> str:
     """The command that writes ``run_file``: a built-in scene (or SCENE:CASE) named by
     its folder (``runs/blast_paper_dx1.2`` -> ``blast_paper:dx1.2``), ``make demo``
@@ -202,7 +212,7 @@ def provenance(runs) -> list[str]:
         ("the gas acts on (interacts_with)",
          lambda r: "not in report.json" if model(r, "gas_acts_on") is None
          else ", ".join(model(r, "gas_acts_on")) or "nothing"),
-        ("run file", lambda r: f"`{get(r, 'run_file')}`"),
+        ("run file", lambda r: f"`{_shown_path(get(r, 'run_file'))}`"),
         ("report.json", lambda r: f"`{r['input'].report_dir / 'report.json'}` → "
          f"`{r['md_dir']}/report.json`"),
         ("run id", lambda r: get(r, "run_id")),
@@ -511,7 +521,7 @@ def run_section(k, r) -> list[str]:
 def render(runs, command, code_commit, notes, base=None) -> str:
     L = ["# Validation record", "",
          f"Made by `{command}` (postprocess at commit {code_commit}); `make validate` "
-         "re-creates it from the run files in `VALIDATE_RUNS` (mk/validate.mk).  Every number "
+         "re-creates it from the run files in `VALIDATE_RUNS` (studies/validate.mk).  Every number "
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
     L += (summary_table(runs, base) + provenance(runs) + coverage_table(runs) + targets_table(runs)

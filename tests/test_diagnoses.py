@@ -1,4 +1,4 @@
-"""The closed form behind `make diagnoses` (benchmarks/diagnoses/wave_speed.py): the
+"""The closed form behind `make diagnoses` (studies/diagnoses/wave_speed.py): the
 cylindrical cavity under a pressure history, checked against two limits computed
 here — causality (nothing before (r - a)/c_P) and the quasi-static Lamé field
 sigma_rr = -p a^2 / r^2 for a slow load."""
@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT
 
 spec = importlib.util.spec_from_file_location(
-    "wave_speed", ROOT / "benchmarks" / "diagnoses" / "wave_speed.py")
+    "wave_speed", ROOT / "studies" / "diagnoses" / "wave_speed.py")
 ws = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(ws)
 
@@ -50,7 +50,7 @@ def test_a_slow_load_gives_the_lame_field():
 
 
 def test_potentials_where_totals_are_the_ledgers_terms(tmp_path):
-    """benchmarks/diagnoses/potentials_where.py on a fracturing run's checkpoint, read
+    """studies/diagnoses/potentials_where.py on a fracturing run's checkpoint, read
     on another rank count (2 against the run's 1): its table's per-(material, code)
     rows add up to its "all" row, count every point once, and its totals are the
     ledger's hourglass and spring terms at the checkpoint's step as the run booked
@@ -70,7 +70,7 @@ def test_potentials_where_totals_are_the_ledgers_terms(tmp_path):
         assert round(f["time"][k] / f.attrs["dt"]) == 200
         hg, sp = f["energy/hourglass"][k], f["energy/spring"][k]
         n_points = int(f.attrs["n_points"])
-    res = run_mpi_script(ROOT / "benchmarks" / "diagnoses" / "potentials_where.py", 2,
+    res = run_mpi_script(ROOT / "studies" / "diagnoses" / "potentials_where.py", 2,
                          str(out / "checkpoint.h5"))
     assert res.returncode == 0, res.stderr
     assert "step 200" in res.stdout
@@ -86,14 +86,14 @@ def test_potentials_where_totals_are_the_ledgers_terms(tmp_path):
 
 
 def test_zone_split_reads_a_failed_annulus_as_area_over_dx():
-    """benchmarks/diagnoses/zone_split.py on a hand-built section: a square lattice at
+    """studies/diagnoses/zone_split.py on a hand-built section: a square lattice at
     0.3 mm inside r = 10 mm and 0.8 mm beyond (the seamless band's), the annulus 3.2-10
     mm failed through and nothing else.  Its share of zone 1 is counted here as failed
     points x dx over the zone's area, and it is within the lattice's rounding of
     area(annulus) / (dx area(zone 1)); the part beyond 10 mm adds nothing, and the two
     shares add up to crack_density's zone."""
     spec = importlib.util.spec_from_file_location(
-        "zone_split", ROOT / "benchmarks" / "diagnoses" / "zone_split.py")
+        "zone_split", ROOT / "studies" / "diagnoses" / "zone_split.py")
     zs = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(zs)
     rw, ro, rs = 3.2e-3, 72e-3, 10e-3

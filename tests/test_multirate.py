@@ -195,7 +195,7 @@ def test_state_following_classes_and_the_ledger(buffer):
     (refresh_after_break on, as in test_ledger's bound for this impact: without
     it the pre-break force of every breakage is a first-order error of its own).
     Without the fracture rule (fracture_window = 0) it closes to 3.6e-4 (graded) and
-    1.5e-4 (full) only: benchmarks/ring_factors.py --windows, docs/multirate.md."""
+    1.5e-4 (full) only: studies/multirate/ring_factors.py --windows, docs/multirate.md."""
     over = ["parts.0.dx=0.0015", "time.dt=6.25e-8", "time.t_end=6e-6", "output.every=40",
             f'time.multirate={{max_ratio=4, safety=0.9, buffer="{buffer}"}}',
             "solver.refresh_after_break=true"]
@@ -212,7 +212,7 @@ def test_state_following_classes_and_the_ledger(buffer):
     assert np.all(k[(r < 0.006) & (sim.mode[:n] == 0)] < 2)   # the crushed zone went fine
     # measured under the row-sum family factor 3.1e-5 full, 2.9e-5 graded (the shape
     # tensor's 4.2e-5, 3.9e-5; single-rate: 1.7e-6); bond states evaluated 0.467 full,
-    # 0.382 graded; 340 and 348 failed points (benchmarks/ring_factors.py)
+    # 0.382 graded; 340 and 348 failed points (studies/multirate/ring_factors.py)
     assert bal < 1e-4
     # the multirate term is needed: without it the ledger would not close to the bound
     assert abs(e.multirate) / e.scale > 1e-3     # measured 2.4e-3
@@ -583,7 +583,7 @@ def test_the_stable_step_fallback_alone_steadies_the_crushed_ball_at_a_coarse_cl
 def test_a_crushed_ball_is_stable_under_the_class_rule_and_not_at_the_coarse_class(factor):
     """The class rule's family factor where it matters: a ball with 95 % of its bonds
     broken is unstable at the rock's class at rest (class 2, held: a single-rate block
-    so cut is unstable at 0.3 x dx / c_p, docs/multirate_family_factor.md), and stable
+    so cut is unstable at 0.3 x dx / c_p, studies/multirate/multirate_family_factor.md), and stable
     under the rule, which puts it finer.  Measured: the held block's energy grows
     1.6e5-fold in 800 steps; under each factor it stays at 1 to 1e-3."""
     held = _energy_growth(_crushed_block(factor, held=2))

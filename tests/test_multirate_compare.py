@@ -1,5 +1,5 @@
 """benchmarks/multirate_compare.py's table: target rows are matched by label, so a
-report made before a row existed (docs/validation/<case>/report.json) shows it as
+report made before a row existed (studies/validation/record/<case>/report.json) shows it as
 missing instead of shifting every row below it."""
 import importlib.util
 from pathlib import Path

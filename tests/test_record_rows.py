@@ -1,4 +1,4 @@
-"""scripts/record_rows.py: each row's input for the record, from its report, its run
+"""studies/validation/record_rows.py: each row's input for the record, from its report, its run
 file, or its committed folder at HEAD (read back from git), else exit status 2."""
 import importlib.util
 import json
@@ -7,7 +7,7 @@ import subprocess
 import pytest
 from conftest import ROOT
 
-spec = importlib.util.spec_from_file_location("record_rows", ROOT / "scripts" / "record_rows.py")
+spec = importlib.util.spec_from_file_location("record_rows", ROOT / "studies" / "validation" / "record_rows.py")
 rr = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(rr)
 
@@ -24,11 +24,11 @@ def test_each_row_from_its_report_its_run_file_or_git(tmp_path):
     assert got == [str(runs / "a" / "report"), str(runs / "b" / "run.h5"), str(rows / "demo")]
     # the demo row as committed at HEAD, file for file
     listed = subprocess.run(["git", "-C", str(ROOT), "ls-tree", "-r", "--name-only", "HEAD",
-                             "docs/validation/demo"], capture_output=True, text=True,
+                             "studies/validation/record/demo"], capture_output=True, text=True,
                             check=True).stdout.split()
     assert sorted(p.name for p in (rows / "demo").iterdir()) == sorted(
         p.rsplit("/", 1)[1] for p in listed)
-    head = subprocess.run(["git", "-C", str(ROOT), "show", "HEAD:docs/validation/demo/report.json"],
+    head = subprocess.run(["git", "-C", str(ROOT), "show", "HEAD:studies/validation/record/demo/report.json"],
                           capture_output=True, check=True).stdout
     assert (rows / "demo" / "report.json").read_bytes() == head
     assert json.loads(head)["run"]["label"] == "blast_demo (demo)"

@@ -136,7 +136,7 @@ def test_a_face_cut_by_a_joint_starts_on_its_correspondence_force(team):
 def test_a_face_cut_by_a_joint_is_stable_beyond_the_critical_step(team):
     """The ground for the start's reference: on the correspondence force, the jointed
     block's faces are stepped stably at 1.5 dt_c (random velocities, 400 steps: the
-    energy stays within 1 % of its start; measured once, docs/validation_notes.md §31,
+    energy stays within 1 % of its start; measured once, studies/validation/notes.md §31,
     the jointed block first blows up between 1.65 and 1.7 dt_c, the uncut one between
     1.7 and 1.8), where the whole-family rule gave its joint points a stable step of
     sqrt(lambda_min(K) / lambda_min(K^0)) dt_c < dt_c."""
@@ -157,7 +157,7 @@ def test_a_face_cut_by_a_joint_is_stable_beyond_the_critical_step(team):
 # -------------------------------------------------- the springs' reference map
 def _stretched_block(team):
     """A 7^3 granite block (dx 1 mm) in the affine field u = (A - I) x of a large,
-    mostly plastic-sized deformation A (the copper tube of docs/validation_notes.md §40
+    mostly plastic-sized deformation A (the copper tube of studies/validation/notes.md §40
     is blown out to 2.3-2.5 times its radius), F computed (initialize); its centre."""
     dx = 1e-3
     sim = Simulation(make_scene(scene_dict({"kind": "box", "lo": [0, 0, 0],

@@ -699,7 +699,7 @@ def test_paper_geometry_with_the_gas_contact_runs_past_the_thinned_tube(tmp_path
     assert got["peak"][cu].max() < 1500.0              # measured 1136 m/s
 
 
-# Issue 15 (docs/validation_notes.md §41): `blast_paper:gas_contact` at the paper's
+# Issue 15 (studies/validation/notes.md §41): `blast_paper:gas_contact` at the paper's
 # 0.8 mm rock stopped at step 2580 (25.8 us) at dt = 1e-8 s with non-finite u in the
 # tube near the detonation face.  This reduction of it (all parts cut to z = 0-25 mm,
 # the rock to r = 20 mm, no probes; 77,292 points) stopped at step 2560 (25.6 us) in the
@@ -734,7 +734,7 @@ def test_paper_geometry_gas_contact_at_the_papers_rock_runs_past_the_thinned_tub
     assert got["peak"][cu].max() < 1500.0              # measured 989 m/s
 
 
-# Issue 15 (docs/validation_notes.md §39-40): `blast_paper:seamless` stopped at step 800
+# Issue 15 (studies/validation/notes.md §39-40): `blast_paper:seamless` stopped at step 800
 # (16 us) with its ledger's `removed` at -183 J: copper tube points near the detonation
 # face, blown out to 2.3-2.5 x the tube's radius, whose F turned singular took the bond
 # springs, which measured their stretch from the reference and so held 21-32 J each.
@@ -747,7 +747,7 @@ def test_paper_geometry_gas_contact_at_the_papers_rock_runs_past_the_thinned_tub
 # from step 761 (speeds 309 -> 1356 m/s and the balance 2e-5 -> 1.4e-3 by step 786)
 # before any point took the springs.  The band's rock gives way, and the tube, blown
 # out to 2.1-2.7 x its radius, thins beyond the paper's dt; the case now halves dt at
-# max_ratio 8 (docs/validation_notes.md §40).
+# max_ratio 8 (studies/validation/notes.md §40).
 SEAMLESS_REDUCED = cut_25mm(["blast_paper:seamless", *PREVIOUS], "0.015", "2.0e-5", 200, 2000)
 
 
@@ -760,7 +760,7 @@ def test_paper_geometry_seamless_tube_on_the_springs_stays_booked(tmp_path):
     assert got["peak"][got["cu"]].max() < 1000.0        # measured 458 m/s
 
 
-# Issue 15/17 (docs/validation_notes.md §26): blast_demo's jittered rock (seed 3) blew
+# Issue 15/17 (studies/validation/notes.md §26): blast_demo's jittered rock (seed 3) blew
 # up single-rate at step 530 at dt = 2 us / 96 (and at step 1360 at 2 us / 120), and at
 # ratio 4 at the scene's dt at step 400: intact correspondence points with 3-5 bonds
 # left and a near-singular K (|K^-1| up to 1e26) that passed the RCOND test.  Such a
@@ -794,7 +794,7 @@ def test_jittered_rock_with_near_singular_shape_tensors_runs_through(tmp_path, r
     assert switched and int(switched.group(1)) > 0, log                # the test acted
 
 
-# Issue 15 (docs/validation_notes.md §34): `blast_paper:paper_coupling` ran to t_end but
+# Issue 15 (studies/validation/notes.md §34): `blast_paper:paper_coupling` ran to t_end but
 # its ledger broke at 14-16 us (balance -0.37, then -0.48): four force-free gas points
 # coasting onto the charge's axis met there, their family compressed them 100-fold in
 # one step and they left at 100-190 km/s with 3.5 kJ unbooked.  This reduction of it

@@ -305,7 +305,7 @@ def test_make_validate_missing_run(tmp_path):
     env["PYTHONPATH"] = str(ROOT)
     missing = tmp_path / "runs" / "blast_paper_dx1.2" / "run.h5"
     p = subprocess.run(["make", "-s", "-o", "install", "validate", f"PY={sys.executable}",
-                        f"VALIDATE_RUNS={missing}", f"VALIDATE_OUT={tmp_path}/docs/validation"],
+                        f"VALIDATE_RUNS={missing}", f"VALIDATE_OUT={tmp_path}/studies/validation/record"],
                        cwd=ROOT, capture_output=True, text=True, timeout=120, env=env)
     assert p.returncode == 2
     lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("make")]

@@ -1,7 +1,7 @@
 """``borehole_multirate``: a borehole-pressure pulse crossing a multi-rate class
 boundary (mpipd.model.multirate; issue 17's "borehole-pressure load").
 
-The elastic granite ring of ``benchmarks/diagnoses/wave_ring_elastic.toml`` (r 3.2 to
+The elastic granite ring of ``studies/diagnoses/wave_ring_elastic.toml`` (r 3.2 to
 30 mm, 12 mm thick, Table 1's moduli, hourglass 0.01) under the borehole pressure
 p(t) = 300 MPa (e^-2e5 t - e^-2e6 t), with probes A, B and C at r = 10, 14 and 25.2 mm.
 The rock with r < 12 mm is held in class 0 and the rest in class log2(ratio)

@@ -114,7 +114,7 @@ class Multirate:
         if self.family_factor == "row_sum_part" and self.safety > PART_SAFETY:
             fail(join(path, "safety"), f'family_factor = "row_sum_part" needs safety <= '
                  f"{PART_SAFETY} (its step for a 95 %-crushed family is 1.5x the measured one, "
-                 f"docs/multirate_family_factor.md; got {self.safety})")
+                 f"studies/multirate/multirate_family_factor.md; got {self.safety})")
         top = self.max_ratio.bit_length() - 1
         if not 0 <= self.fracture_class <= top:
             fail(join(path, "fracture_class"), f"fracture_class must be a class 0..{top} of "
@@ -134,7 +134,7 @@ BUFFERS = ("full", "graded")
 FAMILY_FACTORS = ("row_sum", "row_sum_part", "shape_tensor")
 #: the largest safety of the "row_sum_part" family factor: the granite block's measured
 #: critical step over its step is 1.6 at 0.5 with 95 % of a ball's bonds broken
-#: (benchmarks/family_factor.py), below 1 above 0.8; granite_ring at 0.9 fails more points
+#: (studies/multirate/family_factor.py), below 1 above 0.8; granite_ring at 0.9 fails more points
 PART_SAFETY = 0.5
 
 

@@ -40,7 +40,7 @@ omega_j of the same bond always uses point j's function and horizon.
   configuration the point had reached, not its whole stretch from the reference:
   the standard PMB stretch s = |Y|/|xi| - 1 (G = I) would charge a point that flowed plastically to
   twice its length with springs loaded to s ~ 1, energy its stress never held
-  (docs/validation_notes.md §40).  G is owned-point state, copied to the ghosts
+  (studies/validation/notes.md §40).  G is owned-point state, copied to the ghosts
   with the force data.
 """
 import math

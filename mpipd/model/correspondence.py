@@ -57,7 +57,7 @@ def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
     "shape_tensor" family factor of mpipd.model.multirate).  A point that lost bonds
     until dt_i < dt cannot be stepped stably by any class: with a near-singular K
     (a few bonds left, nearly coplanar) its correspondence force blew up a jittered
-    rock (docs/validation_notes.md §26) although det K passed the RCOND test.  It
+    rock (studies/validation/notes.md §26) although det K passed the RCOND test.  It
     takes the bond springs instead, the paper's fallback for a family too poor for
     K (§2.1).  A point with its family at rest has dt_i = dt_c,i >= dt (``mpipd run``
     holds dt to the estimate; beyond it, ``--force``, the floor is lambda_min(K^0)
@@ -66,13 +66,13 @@ def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
     treated as the part's free surface is (stable at dt_c, though its K is as soft);
     with the whole family as reference the fragment bench's cubes cut by joints, at
     0.55 dt_c, started with 1728 of 97,336 points (the 8 around each joint crossing) on
-    the springs (docs/validation_notes.md §31).  A crack's face, formed in the run, is
+    the springs (studies/validation/notes.md §31).  A crack's face, formed in the run, is
     still measured against the intact family.  The estimate errs on the safe side
     (multirate's measurements: a point with 95 % of its bonds broken has 0.001 of dt_c
     by it, 0.10-0.15 measured); but in such a ball (tests/test_multirate.py,
     _crushed_block) the points it takes off are the unstable ones: held at 4 dt, the
     ball's energy grew 1.6e5-fold in 800 steps without the rule and stays within 1e-7
-    with it (84 points on the springs; docs/validation_notes.md §28)."""
+    with it (84 points on the springs; studies/validation/notes.md §28)."""
     r = np.minimum(np.asarray(dt_ratio, float), 1.0)
     return r * r * np.maximum(lam0, 0.0)
 

@@ -63,8 +63,8 @@ it, which errs on the safe side.  kappa_i follows the bonds lost around the poin
   grew by R_i / R_i^0 needs its step shortened by at most sqrt of it.  It counts every
   element a point takes impulses from, its own and its neighbours', each with the
   bonds it still has; a free surface and a crack face look alike (each relative to
-  its own reference).  Measured (benchmarks/family_factor.py,
-  docs/multirate_family_factor.md): a granite block with a planar crack, two crossed
+  its own reference).  Measured (studies/multirate/family_factor.py,
+  studies/multirate/multirate_family_factor.md): a granite block with a planar crack, two crossed
   cracks or a ball with 30 % of its bonds broken keeps the intact block's critical
   step; balls with 60-95 % broken lose 13-90 % of it, about what the row sum says
   (at 95 %: 0.10-0.15 of it measured, 0.15 said: an estimate, not a bound; the
@@ -86,7 +86,7 @@ Both are 1 off the correspondence force (the gas, the bond-spring fallback) and 
 point that failed (its own stress no longer follows its material), as the smallest
 stretch is, and are recomputed where a family changed (bonds broke) and, for the
 row sum, around it.  A copper tube driven to 2.4 x its radius is
-thinned to lambda = 0.25 (docs/validation_notes.md §13).  A point whose dt_i is
+thinned to lambda = 0.25 (studies/validation/notes.md §13).  A point whose dt_i is
 below dt itself cannot be helped by any class (class 0 is dt): the boundary
 counts it (``over``), and the run log and the error of an unstable run name the
 worst such point; the scene's remedy is a smaller dt with a larger max_ratio
@@ -318,7 +318,7 @@ class StepClasses:
     def base_classes(self, corr, halo, step: int = 0, kappa: bool = True, fracture: bool = True,
                      fracture_class: int | None = None) -> np.ndarray:
         """Each owned point's class from its own material and state (module docstring).
-        A study of the rule (benchmarks/class_rules.py) may leave out the family factor
+        A study of the rule (studies/multirate/class_rules.py) may leave out the family factor
         (``kappa``) or the fracture rule (``fracture``), or change ``fracture_class``
         (None: the scene's)."""
         n = self.n_owned
