@@ -528,7 +528,7 @@ def _lattice_update(gas_mask, a=2.0e5, h=4.0e-4):
     """One gas_update on a 7 x 7 x 7 cubic lattice (spacing h, gas horizon 3h) under
     the affine compression v = -a x, every listed gas point lit at its loaded density:
     returns (gd, e, n_bad, gas_idx, centre index)."""
-    from mpipd.kernels.ul import gas_update
+    from mpipd.kernels.ul import GasParams, gas_update
     g = (np.arange(7) - 3) * h
     x = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     n = len(x)
@@ -545,9 +545,9 @@ def _lattice_update(gas_mask, a=2.0e5, h=4.0e-4):
     e = np.full(len(gas_idx), 7.38e9)
     dt = 2.0e-8
     n_bad, _ = gas_update(gas_idx, x.copy(), -a * x, V, V.copy(), V.copy(), gd, delta, offsets,
-                          nbr, dt, 1.0, np.zeros(len(gas_idx)), 0.0, V[gas_idx].copy(), e,
-                          568e9, 21.6e9, 5.81, 1.77, 0.282, 1.0, is_gas,
-                          np.zeros(len(gas_idx)), np.zeros(len(gas_idx)))
+                          nbr, dt, 1.0, np.zeros(len(gas_idx)), V[gas_idx].copy(), e, is_gas,
+                          np.zeros(len(gas_idx)), np.zeros(len(gas_idx)),
+                          GasParams(0.0, 568e9, 21.6e9, 5.81, 1.77, 0.282, 1.0))
     centre = int(np.flatnonzero(np.all(x == 0.0, axis=1))[0])
     return gd, e, n_bad, gas_idx, centre, x, dt
 

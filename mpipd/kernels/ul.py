@@ -82,6 +82,7 @@ equal and opposite, a potential force (:func:`gas_contact_energy`).
 Per point, the halo carries gd = [A (6, Voigt), V, p].
 """
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -138,10 +139,31 @@ def well_posed(M, nb):
     return nb >= MIN_NEIGHBOURS and det3(M) > RCOND_M * (tr / 3.0) ** 3
 
 
+class GasParams(NamedTuple):
+    """The constants of one explosive as :func:`gas_update` reads them (SI): the burn
+    ramp t_ramp (s; 0: lit at once), JWL's A, B, R1, R2, omega (Eq. 48), the factor
+    kfac on the products' pressure (``pressure_factor``), the charge's density rho0,
+    the bulk viscosity's c_q, c_l (0, 0: none) and the unreacted EOS K_u, s_u, a_u
+    (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none).  One named pack, so that
+    no two constants can be swapped by position."""
+    t_ramp: float
+    A: float
+    B: float
+    R1: float
+    R2: float
+    w: float
+    kfac: float
+    rho0: float = 1.0
+    c_q: float = 0.0
+    c_l: float = 0.0
+    K_u: float = 0.0
+    s_u: float = 0.0
+    a_u: float = 1.0
+
+
 @numba.njit(cache=True)
-def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit, t_ramp,
-               V0, e, A, B, R1, R2, w, kfac, is_gas, vr_lit, gq, rho0=1.0, c_q=0.0,
-               c_l=0.0, K_u=0.0, s_u=0.0, a_u=1.0):
+def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, t_lit,
+               V0, e, is_gas, vr_lit, gq, prm):
     """Advance volume, energy and pressure of the owned gas points ``gas_idx`` and
     fill their force data gd[i] = [A (Voigt 6), V, p].  offsets/nbr: current families
     (rows = owned points); ``V_w`` the gas volumes at the start of the step (this
@@ -152,8 +174,10 @@ def gas_update(gas_idx, y, v, V_ref, V_w, V_pw, gd, delta, offsets, nbr, dt, t, 
     this step (J, module docstring).  ``vr_lit[k]``: V_R of point k at the step it is
     first lit (0 until then).  ``gq[k]``: its bulk viscosity q of the last step,
     replaced by this step's; rho0, c_q, c_l: the charge's density and the
-    viscosity's coefficients.  K_u, s_u, a_u: the unreacted EOS
-    (mpipd.materials.jwl.unreacted_pressure; K_u = 0: none)."""
+    viscosity's coefficients, and the rest of the charge's constants, are in ``prm``
+    (:class:`GasParams`)."""
+    t_ramp, A, B, R1, R2, w, kfac = prm.t_ramp, prm.A, prm.B, prm.R1, prm.R2, prm.w, prm.kfac
+    rho0, c_q, c_l, K_u, s_u, a_u = prm.rho0, prm.c_q, prm.c_l, prm.K_u, prm.s_u, prm.a_u
     M = np.empty((3, 3))
     Mg = np.empty((3, 3))
     Mi = np.empty((3, 3))

@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -176,13 +177,40 @@ def strength_envelope(ps, rate, A, N, B, M, T_star):
     return si, sf
 
 
+class JH2Params(NamedTuple):
+    """The constants of one JH2 material as :func:`jh2_kernel` reads them (SI; the
+    names of Table 1 and Eqs. 19-36): shear modulus G, the EOS K1 (= lambda + 2G/3),
+    K2, K3, sigma_HEL = 1.5 (HEL - p_HEL), p_HEL, the strength constants A, N, B, M,
+    the rate constant C with edot_n = rate_norm, the static tensile strength T0,
+    the bulking fraction beta, the damage constants D1, D2, and the pressure choice
+    (``incremental``: Eq. 35, else Eq. 25).  Built by :attr:`JH2.params`; one named
+    pack, so that no two constants can be swapped by position."""
+    G: float
+    K1: float
+    K2: float
+    K3: float
+    sigma_hel: float
+    p_hel: float
+    A: float
+    N: float
+    B: float
+    M: float
+    C: float
+    T0: float
+    beta: float
+    D1: float
+    D2: float
+    rate_norm: float
+    incremental: bool
+
+
 @numba.njit(cache=True)
 def jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, p_el, pressure, rate_out,
-               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
-               t_factor, incremental):
+               t_factor, prm):
     """Advance the unrotated stress of the JH2 points ``idx`` (state arrays are
     compact: entry k belongs to point idx[k]).  Sets mode[i] on failure.
-    ``t_factor``: entry k's factor on T (mpipd.materials.heterogeneity), or empty.
+    ``t_factor``: entry k's factor on T (mpipd.materials.heterogeneity), or empty;
+    ``prm``: the material's :class:`JH2Params`.
 
     ``incremental`` False (``pressure = "eos"``): p0 = Eq. 25 at mu = 1/J - 1
     (:func:`jh2_pressure`; ``p_el`` is not read and may be empty).  True
@@ -191,6 +219,10 @@ def jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, p_el, pressure, rate_ou
     lowers p); J, K2 and K3 are not read.  Either way p = p0 + dp, with p* = p /
     p_HEL in Eqs. 22, 23, 30 and the tensile check p < -T, and bulking (Eq. 26) on
     p_lin = K1 mu or p_el (the module docstring, steps 1 and 6)."""
+    G, K1, K2, K3 = prm.G, prm.K1, prm.K2, prm.K3
+    sigma_hel, p_hel, A, N, B, M = prm.sigma_hel, prm.p_hel, prm.A, prm.N, prm.B, prm.M
+    C, T0, beta, D1, D2, rate_norm = prm.C, prm.T0, prm.beta, prm.D1, prm.D2, prm.rate_norm
+    incremental = prm.incremental
     hetero = t_factor.shape[0] > 0
     for k in range(idx.shape[0]):
         i = idx[k]
@@ -254,17 +286,6 @@ def jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, p_el, pressure, rate_ou
         sigma[i, 5] = s[5]
 
 
-@numba.njit(cache=True)
-def jh2_update(idx, d, J, dt, sigma, mode, D, eps_p, dp, pressure, rate_out,
-               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
-               t_factor):
-    """:func:`jh2_kernel` under ``pressure = "eos"`` (the argument list callers
-    before the ``pressure`` choice use)."""
-    jh2_kernel(idx, d, J, dt, sigma, mode, D, eps_p, dp, np.zeros(0), pressure, rate_out,
-               G, K1, K2, K3, sigma_hel, p_hel, A, N, B, M, C, T0, beta, D1, D2, rate_norm,
-               t_factor, False)
-
-
 @MATERIALS.register("jh2")
 @dataclass(frozen=True)
 class JH2(Material):
@@ -313,6 +334,15 @@ class JH2(Material):
         return self.pressure == "incremental"
 
     @property
+    def params(self) -> JH2Params:
+        """The kernel's constants (:class:`JH2Params`)."""
+        return JH2Params(float(self.shear_modulus), float(self.bulk_modulus), float(self.K2),
+                         float(self.K3), float(self.sigma_hel), float(self.p_HEL),
+                         float(self.A), float(self.N), float(self.B), float(self.M),
+                         float(self.C), float(self.T), float(self.beta), float(self.D1),
+                         float(self.D2), float(self.rate_norm), bool(self.incremental))
+
+    @property
     def sigma_hel(self) -> float:
         return 1.5 * (self.HEL - self.p_HEL)
 
@@ -337,10 +367,7 @@ class JH2(Material):
         s = state
         jh2_kernel(idx, d, J, dt, sigma, mode, s["D"], s["eps_p"], s["dp"],
                    s.get("p_el", NO_P_EL), s["pressure"], s["strain_rate"],
-                   self.shear_modulus, self.bulk_modulus, self.K2, self.K3, self.sigma_hel,
-                   self.p_HEL, self.A, self.N, self.B, self.M, self.C, self.T, self.beta,
-                   self.D1, self.D2, self.rate_norm, self.strength_factor(s, "T"),
-                   self.incremental)
+                   self.strength_factor(s, "T"), self.params)
 
     def point_strength(self, state: dict, pos: int) -> float:
         """sigma_y = sigma_HEL sigma* (p*, edot*, D) of one point (Eqs. 20–22, the

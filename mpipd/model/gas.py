@@ -49,7 +49,7 @@ from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows, near_cells
-from ..kernels.ul import gas_contact_energy, gas_gather, gas_update
+from ..kernels.ul import GasParams, gas_contact_energy, gas_gather, gas_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
 from .base import Model
@@ -129,6 +129,10 @@ class Gas(Model):
         self.n_singular = 0
         self.peak_pressure = 0.0                 # largest gas pressure so far (owned)
         self.c_q, self.c_l = m.bulk_viscosity
+        self.params = GasParams(float(self.t_ramp), float(m.A), float(m.B), float(m.R1),
+                                float(m.R2), float(m.omega), float(m.pressure_factor),
+                                float(m.density), float(self.c_q), float(self.c_l),
+                                *map(float, m.unreacted_eos))
         self.contact_frac, self.contact_k = m.contact_law
         self.viscous = self.c_q > 0.0 or self.c_l > 0.0
         self.gq = np.zeros(len(self.gas_idx))    # bulk viscosity q of the last step
@@ -296,9 +300,8 @@ class Gas(Model):
         t0 = time.perf_counter()
         self.n_singular, wq = gas_update(
             self.gas_idx, y, self.v_ext, self.vol_ext, self.V_w, self.V_pw, self.gd,
-            p.horizon, self.offsets, self.nbr, dt, t, self.t_lit, self.t_ramp, self.V0, self.e,
-            m.A, m.B, m.R1, m.R2, m.omega, m.pressure_factor, self.isgas_ext, self.vr_lit,
-            self.gq, m.density, self.c_q, self.c_l, *m.unreacted_eos)
+            p.horizon, self.offsets, self.nbr, dt, t, self.t_lit, self.V0, self.e,
+            self.isgas_ext, self.vr_lit, self.gq, self.params)
         self.tuner.step(time.perf_counter() - t0)
         self.viscous_work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
