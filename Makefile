@@ -13,7 +13,19 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install paraview lammps demo test bench lint clean
+.PHONY: help install paraview lammps demo demo-figure test test-quick bench lint clean
+
+# the user targets, one line each (research targets live in studies/*.mk: studies/README.md)
+help:
+	@echo "make install      set-up once: Debian Open MPI + parallel HDF5, .venv, mpi4py, h5py, mpipd"
+	@echo "make demo         the built-in scene blast_demo on 2 ranks, its picture and report (runs/demo)"
+	@echo "make test         every test CI runs (serial, mpirun -n 2 and -n 3), under 20 minutes"
+	@echo "make test-quick   the serial unit tests only (no mpirun, no long cases)"
+	@echo "make docs         the documentation site from docs/ into site/, strict"
+	@echo "make bench        throughput and memory of the kernels, beside LAMMPS"
+	@echo "make verify       error against run time of the verification problems, then make stability"
+	@echo "make lint         ruff"
+	@echo "make clean        remove runs/ and the pytest cache"
 
 install: $(STAMP)
 
@@ -35,8 +47,18 @@ demo: install
 	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/demo/run.h5 --out runs/demo/report
 	@echo "demo: the fracture pattern is in $(CURDIR)/runs/demo/fracture.png (validation report: runs/demo/report/report.md, fields: runs/demo/run.h5, ParaView: runs/demo/run.xdmf)"
 
+# the README's picture: make demo first; the caption names the run file's commit
+demo-figure:
+	@test -f runs/demo/fracture.png || { echo "make demo-figure: runs/demo/fracture.png is missing: run make demo first"; exit 2; }
+	mkdir -p docs/img && cp runs/demo/fracture.png docs/img/demo_fracture.png
+	@$(PY) -c "import h5py; print('demo-figure: run file at commit', h5py.File('runs/demo/run.h5', 'r').attrs['git_commit'][:7])"
+
 test: install paraview
 	$(PY) -m pytest -q -ra tests
+
+# the serial tier: no test that launches mpirun (marker `mpi`, applied in tests/conftest.py)
+test-quick: install
+	$(PY) -m pytest -q -ra -m "not mpi and not long" tests
 
 bench: install lammps
 	$(PY) benchmarks/run.py

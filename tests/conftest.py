@@ -4,7 +4,9 @@ Serial tests run the solver in-process on a one-rank communicator; MPI tests
 run the CLI or a script under ``mpirun`` with a timeout, so a deadlock fails
 instead of hanging.
 """
+import inspect
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -127,7 +129,49 @@ def pytest_addoption(parser):
                      help="also run the tests marked `long` (minutes each; make stability)")
 
 
+#: what launches mpirun in a test's source: run_cli(..., ranks=N), restart_matches,
+#: run_mpi_script, or a command list that starts with "mpirun"
+_MPIRUN = re.compile(r"\brun_cli\((?:[^()]|\([^()]*\))*?\branks\s*=|\brestart_matches\("
+                     r"|\brun_mpi_script\(|[\[(=]\s*[\"']mpirun[\"']")
+_CALL = re.compile(r"\b([A-Za-z_]\w*)\(")
+
+
+def _sources(item):
+    """The source of a test function, of every fixture it uses that is defined under
+    tests/, and of the functions of the test's own module that these call (transitively)."""
+    here = Path(__file__).resolve().parent
+    module = getattr(item, "module", None)
+    todo = [getattr(item, "function", None)]
+    defs = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {}) or {}
+    for fdefs in defs.values():
+        todo += [d.func for d in fdefs]
+    seen, out = set(), []
+    while todo:
+        f = todo.pop()
+        if f is None or f in seen:
+            continue
+        seen.add(f)
+        try:
+            if Path(inspect.getsourcefile(f)).resolve().parent != here:
+                continue
+            src = inspect.getsource(f)
+        except (OSError, TypeError):
+            continue
+        out.append(src)
+        for name in _CALL.findall(src):
+            g = getattr(module, name, None)
+            if inspect.isfunction(g) and g.__module__ == getattr(module, "__name__", None):
+                todo.append(g)
+    return out
+
+
 def pytest_collection_modifyitems(config, items):
+    """Mark every test that launches mpirun (directly or through a fixture) ``mpi``, so
+    that ``-m "not mpi"`` (make test-quick) is the serial tier; skip the ``long`` ones
+    unless --long."""
+    for item in items:
+        if any(_MPIRUN.search(src) for src in _sources(item)):
+            item.add_marker(pytest.mark.mpi)
     if config.getoption("--long"):
         return
     skip = pytest.mark.skip(reason="a long stability case: run by `make stability` "
