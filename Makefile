@@ -25,7 +25,7 @@ help:
 	@echo "make bench        throughput and memory of the kernels, beside LAMMPS"
 	@echo "make verify       error against run time of the verification problems, then make stability"
 	@echo "make lint         ruff"
-	@echo "make clean        remove runs/ and the pytest cache"
+	@echo "make clean        remove caches (pytest, __pycache__, site/); never runs/"
 
 install: $(STAMP)
 
@@ -68,8 +68,10 @@ bench: install lammps
 lint: install
 	$(VENV)/bin/ruff check .
 
+# caches only: runs/ (every run's home by default) is never deleted by make
 clean:
-	rm -rf runs .pytest_cache
+	rm -rf .pytest_cache site
+	find . -path ./.venv -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
 
 # further targets (verify, jobs-test, ...) live in mk/*.mk, one file a topic
 -include mk/*.mk studies/*.mk
