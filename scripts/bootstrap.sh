@@ -3,7 +3,8 @@
 #   1. Debian packages: Open MPI and the MPI build of HDF5 (apt, needs root or sudo)
 #   2. a virtualenv at .venv with numpy, scipy, numba, pytest
 #   3. mpi4py built against the system Open MPI, h5py built against parallel HDF5
-#   4. mpipd itself, editable
+#   4. mpipd itself, editable, and the pinned tools of its documentation site
+#      (pyproject.toml's `docs` extra: mkdocs-material, mkdocstrings; `make docs`)
 # Fails loudly if h5py lacks MPI support.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -45,4 +46,11 @@ fi
   || { echo "bootstrap: h5py was built WITHOUT MPI support; parallel output cannot work" >&2; exit 1; }
 
 "$PY" -m pip install -q --no-deps --no-build-isolation -e .
+# the docs extra's pins, read from pyproject.toml (not `pip install -e .[docs]`, which
+# would also resolve h5py and mpi4py again, from wheels without MPI)
+"$PY" - <<'PYEOF' > "$VENV/.docs-requirements.txt"
+import tomllib
+print("\n".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["docs"]))
+PYEOF
+"$PY" -m pip install -q -r "$VENV/.docs-requirements.txt"
 echo "bootstrap: done"

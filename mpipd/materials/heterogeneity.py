@@ -88,6 +88,8 @@ class Distribution:
 @DISTRIBUTIONS.register("weibull")
 @dataclass(frozen=True)
 class Weibull(Distribution):
+    """Weibull factors of ``modulus`` m > 0: f = lambda (-ln(1 - u))^(1/m) with
+    lambda = 1 / Gamma(1 + 1/m), so that the mean factor is 1."""
     modulus: float | None = None
     required = ("applies_to", "modulus")
 
@@ -112,6 +114,7 @@ class Weibull(Distribution):
 @DISTRIBUTIONS.register("uniform")
 @dataclass(frozen=True)
 class Uniform(Distribution):
+    """Uniform factors on [1 - w, 1 + w], ``width`` w in [0, 1): f = 1 + w (2u - 1)."""
     width: float | None = None
     required = ("applies_to", "width")
 
@@ -131,6 +134,9 @@ class Uniform(Distribution):
 @DISTRIBUTIONS.register("normal")
 @dataclass(frozen=True)
 class Normal(Distribution):
+    """Normal factors f = 1 + cv z, z standard normal truncated to [-t, t]
+    (``truncate`` t, default 3) by inverse-CDF sampling: mean 1 exactly; ``cv`` is
+    the untruncated standard deviation, and cv t < 1 keeps every factor > 0."""
     cv: float | None = None
     truncate: float = 3.0
     required = ("applies_to", "cv")
