@@ -87,7 +87,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..materials.jwl import jwl_cold, jwl_sound_speed2, unreacted_pressure, unreacted_sound_speed2
+from .eos import jwl_cold, jwl_sound_speed2, unreacted_pressure, unreacted_sound_speed2
 from .index import family, neighbour
 from .layout import GD_P, GD_V
 from .linalg import det3, inv3

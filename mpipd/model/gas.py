@@ -79,6 +79,62 @@ def lighting_times(scene, part: np.ndarray, x: np.ndarray, mat) -> np.ndarray:
     return t
 
 
+def check_charges(scene) -> None:
+    """Bad input (SceneError, one line naming the key) for a charge that the run
+    would not light as its scene says: a plane (the charge's own ``initiation``, or
+    its material's initiation_z and direction) more than a dx from the charge's end
+    face the front leaves from -- outside it, a late start, or inside or beyond it,
+    lighting the points behind it at once; a primer ``point`` more than a dx from
+    every point of the charge; and a charge none of whose points is lit before the
+    run's end (``initiation.never = true`` says so on purpose).  On the unjittered
+    lattice (mpipd.input.geometry.part_points); ``mpipd run`` and ``mpipd check`` call it."""
+    from ..input.geometry import part_points
+    from ..input.schema import fail
+    t_end = scene.time.n_steps * scene.time.dt
+    for k, q in enumerate(scene.parts):
+        if q.material not in scene.gas_materials:
+            continue
+        mat, ini = scene.materials[q.material], q.initiation
+        if ini is not None and ini.never:
+            continue
+        pts = part_points(q)
+        if ini is not None and ini.point is not None:
+            d = float(np.linalg.norm(pts - np.asarray(ini.point), axis=1).min())
+            if d > q.dx:
+                fail(f"parts[{k}].initiation.point",
+                     f"the primer point {list(ini.point)} m lies {d * 1e3:.3g} mm from the "
+                     f"nearest point of charge {q.name!r} (more than its dx, "
+                     f"{q.dx * 1e3:.3g} mm): outside it, lit {d / mat.vod * 1e6:.3g} us late")
+        else:
+            z0, sign = (ini.z, ini.direction) if ini is not None else (mat.initiation_z,
+                                                                        mat.direction)
+            key = (f"parts[{k}].initiation.z" if ini is not None
+                   else f"materials.{q.material}.initiation_z")
+            lo, hi = float(pts[:, 2].min()) - 0.5 * q.dx, float(pts[:, 2].max()) + 0.5 * q.dx
+            face = lo if sign > 0 else hi
+            ahead = (pts[:, 2] - z0) * sign          # the front's distance to each point
+            where = (f"the initiation plane z = {z0:g} m ({'+' if sign > 0 else '-'}z) "
+                     f"of charge {q.name!r} (z {lo:g}..{hi:g} m)")
+            if ahead.min() > q.dx:
+                fail(key, f"{where} lies outside it, {ahead.min() * 1e3:.3g} mm before its "
+                          f"first point (lit {ahead.min() / mat.vod * 1e6:.3g} us late): put "
+                          f"it on the face the front leaves from, z = {face:g} m")
+            if ahead.min() < -q.dx:
+                behind = int(np.count_nonzero(ahead < 0.0))
+                fail(key, f"{where} lies {'beyond' if ahead.max() < 0 else 'inside'} it: "
+                          f"{behind} of its {len(pts)} points are behind the plane and lit "
+                          f"at once at t = {(ini.time if ini is not None else 0.0) * 1e6:.4g} "
+                          f"us; put it on the face the front leaves from, z = {face:g} m")
+        first = float(lighting_times(scene, np.full(len(pts), k), pts, mat).min())
+        if not first < t_end:
+            timed = ini is not None and ini.time > 0
+            fail(f"parts[{k}].initiation" + (".time" if timed else ""),
+                 f"charge {q.name!r} is first lit at {first * 1e6:.4g} us, not before the "
+                 f"run's end t_end = {t_end * 1e6:.4g} us: none of it burns in this run (run "
+                 "to its time and stop earlier with --stop-after, or set initiation.never = "
+                 "true for a charge never lit)")
+
+
 class Gas(Model):
     name = "gas"
 
@@ -291,7 +347,7 @@ class Gas(Model):
 
     def update(self, u, v, dt: float, t: float):
         """Families, then volume, energy, pressure and force data of the owned gas."""
-        p, m = self.points, self.mat
+        p = self.points
         np.add(p.x, u, out=self._y)
         self.search(self._y, v)
         y = self.y = self.y_ext                 # current positions, kept for gather()
