@@ -1,0 +1,67 @@
+"""README.md stays short, true and runnable: its validation table says what the record
+says, its scene of your own passes `mpipd check`, and every file it links exists."""
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import tomllib
+
+from postprocess.targets import TARGETS
+from postprocess.validation import judged
+
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text()
+
+
+def _base_case() -> str:
+    """The record's base row, as `make validate` names it (studies/validate.mk)."""
+    mk = (ROOT / "studies" / "validate.mk").read_text()
+    return re.search(r"^VALIDATE_BASE \?= (\S+)$", mk, re.M).group(1)
+
+
+def _status_rows() -> list[tuple[str, str]]:
+    """(quantity, verdict) of the README's table under "## Validation status"."""
+    section = README.split("## Validation status", 1)[1].split("\n## ", 1)[0]
+    rows = [line.strip("|").split("|") for line in section.splitlines()
+            if line.startswith("| ") and not line.startswith("| judged")]
+    return [(q.strip(), v.strip()) for q, v in rows]
+
+
+def test_short():
+    assert len(README.splitlines()) <= 200
+    assert "§" not in README                    # no references into the research notes
+    assert "/work/" not in README and "/home/" not in README
+
+
+def test_status_table_is_the_records():
+    """One row per judged quantity of the base row's report.json, in the record's order,
+    each with the verdict the record gives it now (postprocess.validation.judged)."""
+    doc = json.loads((ROOT / "studies" / "validation" / "record" / _base_case()
+                      / "report.json").read_text())
+    got = judged(doc)
+    expected = [got[t.key][1] for t in TARGETS
+                if t.kind in ("range", "consistency") and t.key in got]
+    assert [v for _, v in _status_rows()] == expected
+
+
+def test_scene_of_your_own_checks(tmp_path):
+    block = re.search(r"```toml\n(.*?)```", README, re.S).group(1)
+    scene = tomllib.loads(block)
+    assert scene["scene"]["name"] == "my_block"
+    path = tmp_path / "my_block.toml"
+    path.write_text(block)
+    res = subprocess.run([sys.executable, "-m", "mpipd.cli", "check", str(path)],
+                         capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "OK" in res.stdout
+
+
+def test_links_exist():
+    for target in re.findall(r"\]\(([^)#\s]+)\)", README):
+        if "://" in target:
+            continue
+        assert (ROOT / target).exists(), f"README links a missing file: {target}"
