@@ -38,8 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .input.geometry import LayerTable, part_points
-from .model.gas import lighting_times
+from .input.geometry import LayerTable, fill_layers, part_points
+from .input.loads import refuse_empty, regions
+from .model.gas import check_charges, lighting_times
 from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
@@ -296,8 +297,57 @@ def gb(n: float) -> str:
     return f"{n / 1e9:.3g} GB"
 
 
+#: points generated at once by :func:`lattice_checks` (memory: about 40 bytes a point)
+CHECK_CHUNK = 2_000_000
+
+
+def lattice_checks(scene, table) -> list[str]:
+    """What ``mpipd run`` checks on its built points, here on the same points
+    (mpipd.input.geometry.fill_layers, the lattice the run makes, jitter included),
+    a few million at a time: every initial or boundary region holds a point
+    (mpipd.input.loads.refuse_empty) and every probe's point is within its horizon
+    (mpipd.output.probes.nearest and placed).  The same rules on the same points:
+    ``mpipd check`` refuses what ``mpipd run`` refuses (SceneError).  Returns the
+    report's lines on the probes (the point each samples; a snap warning)."""
+    from .output.probes import nearest, placed
+    conds = regions(scene)
+    if not conds and not scene.probes:
+        return []
+    parts = scene.parts
+    names = [q.name for q in parts]
+    mid = np.array([scene.material_ids[q.material] for q in parts], np.int32)
+    pdx = np.array([q.dx for q in parts])
+    phor = np.array([q.horizon for q in parts])
+    counts = [0] * len(conds)
+    best = [(math.inf, -1)] * len(scene.probes)
+    ends = np.cumsum(table.count)
+    first = 0
+    while first < len(table.count):                 # layers in gid order
+        last = int(np.searchsorted(ends, ends[first] - table.count[first] + CHECK_CHUNK,
+                                   side="right"))
+        layers = np.arange(first, max(last, first + 1))
+        first = int(layers[-1]) + 1
+        x, part, gid = fill_layers(parts, table, layers)
+        for i, (_, c) in enumerate(conds):
+            counts[i] += int(np.count_nonzero(c.selects(x)))
+        for k, pr in enumerate(scene.probes):
+            best[k] = min(best[k], nearest(pr, names, x, gid, part, mid[part], pdx[part],
+                                           phor[part]))
+    refuse_empty(scene, counts)
+    out = []
+    for k, pr in enumerate(scene.probes):
+        note = placed(k, pr, best[k])
+        dist, g, xg, pg = best[k][:4]
+        out.append(f"  probe {pr.name!r}: point gid {g} of part {names[pg]!r} at ("
+                   + ", ".join(f"{c * 1e3:.4g}" for c in xg) + f") mm, {dist * 1e3:.3g} mm "
+                   "from its position" + (f"; warning: {note}" if note else ""))
+    return out
+
+
 def check_report(scene, ranks: int) -> str:
     table = LayerTable.from_parts(scene.parts, scene.material_ids)
+    check_charges(scene)                     # mpipd run's checks, before any report
+    probe_lines = lattice_checks(scene, table)
     halo = halo_width(scene)
     slabs = decompose(table, ranks, halo, replicated_parts(scene))
     bonds = layer_bonds(scene, table)
@@ -334,7 +384,9 @@ def check_report(scene, ranks: int) -> str:
             ini = p.initiation
             pts = part_points(p)
             t_last = float(lighting_times(scene, np.full(len(pts), k), pts, mat).max())
-            if ini is not None and ini.point is not None:
+            if ini is not None and ini.never:
+                out.append("    initiation: never (initiation.never: unlit gas all run)")
+            elif ini is not None and ini.point is not None:
                 out.append(f"    initiation: from the point ({', '.join(f'{v:g}' for v in ini.point)})"
                            f" m at t = {ini.time * 1e6:.4g} us, the charge lit by "
                            f"{t_last * 1e6:.4g} us")
@@ -419,6 +471,7 @@ def check_report(scene, ranks: int) -> str:
                        f"K3 = {mat.K3:.4g} Pa): the wave speed and the viscosity use K1 there")
     out.append(f"  total: {table.n_points} points, {int(bonds.sum())} bonds "
                f"(counted from the cross-sections)")
+    out.extend(probe_lines)
     for i, jt in enumerate(scene.joints):
         kind = ("a set, spacing " + f"{jt.spacing:g} m" if jt.spacing > 0 else "one joint")
         out.append(f"  joint {i}: {kind} through {list(jt.point)}, normal {list(jt.normal)}, "

@@ -8,13 +8,16 @@
     mpipd cases SCENE           (then run SCENE:CASE)
 
 SCENE is a TOML file or the name of a built-in scene.  Bad input (scene
-errors, an existing output file, a decomposition that cannot work) prints one
-line ``mpipd: error: <what>`` on rank 0 and exits with status 2 on every rank,
-before anything is written.  A run writes only its own files (mpipd.output.rundir:
-run ids, the restart and --overwrite rules).  A file of the run that cannot be
-written (disk full, read-only) prints one line and exits with status 4 (a
-finished run whose end checkpoint fails prints its summary first, and that its
-run file is complete); a blow-up exits with 3; a clean stop with a checkpoint
+errors, an existing output file, a decomposition that cannot work, a corrupted
+checkpoint, and an --out that cannot be written at the start -- read-only, no
+permission -- which rundir.ensure_writable tries before the run's first write)
+prints one line ``mpipd: error: <what>`` on rank 0 and exits with status 2 on
+every rank, before anything is written.  A run writes only its own files
+(mpipd.output.rundir: run ids, the restart and --overwrite rules).  A file of the
+run that cannot be written once the run has begun writing (disk full, a file
+system gone read-only) prints one line and exits with status 4 (a finished run
+whose end checkpoint fails prints its summary first, and that its run file is
+complete); a blow-up exits with 3; a clean stop with a checkpoint
 (--stop-after, SIGTERM or SIGUSR1) with 0.  Any other exception on any rank
 prints its traceback and aborts the whole MPI job, so nothing hangs.
 """
@@ -149,6 +152,7 @@ def _run(args, team, signals=None) -> int:
     from .input import scene as sc
     from .input.geometry import check_parts
     from .input.schema import SceneError
+    from .model.gas import check_charges
     from .output import checkpoint as ck
     from .output import rundir
     from .parallel.decomp import DecompositionError
@@ -206,6 +210,7 @@ def _run(args, team, signals=None) -> int:
                 rundir.check_new_run(out, args.overwrite)
             _on_root(team, new_run_checks)
         check_parts(scene.parts)             # geometry first: empty, oversized, overlapping
+        check_charges(scene)                 # a charge lit from outside it, or after t_end
         dt_stable = critical_dt(scene)
         if scene.time.dt > dt_stable and not args.force:
             raise UsageError(f"time.dt = {scene.time.dt:.4e} s exceeds the stable estimate "
@@ -213,8 +218,7 @@ def _run(args, team, signals=None) -> int:
         hosts = team.gather((socket.gethostname(), _mem_available()))
         _on_root(team, _check_sizes, scene, team.size, hosts, out, args)
         sim = Simulation(scene, team)
-        if args.restart:
-            ck.restore(sim, args.restart)
+        restored = ck.restore(sim, args.restart) if args.restart else None
         # the first write of the run: the folder's lock, then the checks again under it
         # (another run may have started or finished since)
         lock = rundir.RunLock(out) if team.root else None
@@ -243,7 +247,7 @@ def _run(args, team, signals=None) -> int:
         team.barrier()
         try:
             return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
-                           n_steps, dt_stable, run_id, resume)
+                           n_steps, dt_stable, run_id, resume, restored)
         except Exception as e:
             line = rundir.io_line(e, out)
             if line is None:
@@ -365,7 +369,7 @@ def _over_dt(sim, team, scene, failed: bool = False) -> str | None:
 
 
 def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
-            dt_stable, run_id, resume) -> int:
+            dt_stable, run_id, resume, restored=None) -> int:
     from .output import checkpoint as ck
     from .output.writer import Writer
     from .solver import Progress, Unstable
@@ -373,6 +377,8 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
     what = f"restart at step {sim.step_count}, " if args.restart else ""
     log(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
         f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}")
+    if restored:                              # the checkpoint's own warning (no checksums)
+        log(f"mpipd: warning: {restored}")
     if scene.time.dt > dt_stable:
         log(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
             f"{dt_stable:.4e} s (--force); the run may blow up")

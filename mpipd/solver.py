@@ -32,6 +32,7 @@ import numpy as np
 from .check import part_critical_dt
 from .input.geometry import LayerTable
 from .input.joints import cut_joints
+from .input.loads import refuse_empty, regions
 from .kernels import integrate, runaway
 from .kernels.layout import N_MODES, SPRING_K
 from .model.base import Model
@@ -101,6 +102,9 @@ class Simulation:
         # model, exchanged and acted on by Failure, read by the interface correction
         self.mode = st.add("mode", "solver", np.zeros(p.n_local, np.uint8), rows=LOCAL,
                            exchanged=scene.can_fail, checkpoint=True)
+        # a region (initial or boundary) with no point of the body is bad input
+        refuse_empty(scene, [team.sum(int(np.count_nonzero(c.selects(p.x[:n]))))
+                             for _, c in regions(scene)])
         for bc in scene.boundaries:
             self.fixed |= bc.mask(p.x[:n]).astype(np.uint8)
         for ic in scene.initial:

@@ -39,7 +39,10 @@ class UsageError(Exception):
 def summary(run: Run, comm) -> list[str]:
     v = run.field("v") if run.has_field("v") else None
     t = run.time
-    lines = [f"points {run.n_points}  frames {run.frames}  t {t[0]:.4e}..{t[-1]:.4e} s"]
+    held = run.f["time"].shape[0]
+    lines = [f"points {run.n_points}  frames {run.frames}"
+             + (f" (of {held}; the rest not yet written)" if held > run.frames else "")
+             + f"  t {t[0]:.4e}..{t[-1]:.4e} s"]
     if run.has_energy("balance"):
         b = np.abs(run.energy("balance"))
         lines.append(f"energy ledger: largest |balance| {np.nanmax(b):.3e} (relative closure "

@@ -128,12 +128,28 @@ class Run:
         return list(self.f["fields"]) if "fields" in self.f else []
 
     def field(self, name: str, frame=slice(None), span=None) -> np.ndarray:
-        """``/fields/name[frame, lo:hi]`` (or ``[frame, lo + a : lo + b]`` for span (a, b))."""
+        """``/fields/name[frame, lo:hi]`` (or ``[frame, lo + a : lo + b]`` for span (a, b)).
+        ``frame`` counts the written frames only (``frames_written``; a run that
+        stopped early, or is still running, has frames allocated but not yet written,
+        NaN): a slice is cut to them, a negative index counts from the last written."""
         if not self.has_field(name):
             raise KeyError(f"the run has no field {name!r} "
                            f"(it has: {', '.join(self.field_names) or 'none'})")
+        frame = self._written(frame)
         a, b = (0, self.hi - self.lo) if span is None else span
         return self.f["fields"][name][frame, self.lo + a:self.lo + b]
+
+    def _written(self, frame):
+        """``frame`` (an index or a slice) within the written frames."""
+        if isinstance(frame, slice):
+            r = range(self.frames)[frame]
+            return slice(r.start, r.stop if r.stop >= 0 else None, r.step)
+        if isinstance(frame, (int, np.integer)):
+            if not -self.frames <= frame < self.frames:
+                raise IndexError(f"frame {int(frame)}: {self.path} holds {self.frames} "
+                                 "written frame(s)")
+            return int(frame) % self.frames
+        return frame
 
     @property
     def time(self) -> np.ndarray:

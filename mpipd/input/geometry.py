@@ -40,8 +40,10 @@ SHAPES = Registry("shape", "kind")
 
 
 def _cells(lo: float, hi: float, dx: float) -> np.ndarray:
-    """Cell-centre coordinates filling [lo, hi] with spacing dx (n = round(L/dx))."""
-    n = max(1, int(round((hi - lo) / dx)))
+    """Cell-centre coordinates filling [lo, hi] with spacing dx (n = round(L/dx)): none
+    for L below dx/2 (a centre at lo + dx/2 would lie outside; mpipd.input.geometry.
+    check_parts refuses the part, as it refuses a cylinder thinner than the lattice)."""
+    n = int(round((hi - lo) / dx))
     return lo + (np.arange(n) + 0.5) * dx
 
 
@@ -418,7 +420,8 @@ def check_parts(parts) -> None:
                                    f"(at most {MAX_SECTION_POINTS:.0e}); dx is too small")
         pts = (part.shape.cross_section(part.dx) if part.shape.prism
                else part_points(part))
-        if len(pts[0]) == 0:
+        n = len(pts[0]) if part.shape.prism else len(pts)
+        if n == 0 or len(part.shape.z_levels(part.dx)) == 0:
             fail(f"parts[{k}].shape", f"part {part.name!r} holds no lattice point at "
                                       f"dx = {part.dx} (shape smaller than the lattice)")
         sections.append(pts)

@@ -45,6 +45,10 @@ class Region:
     def check(self, path):
         ordered_box(self, path, strict=False)
 
+    @property
+    def what(self) -> str:
+        return f"the region {list(self.lo)}..{list(self.hi)} m"
+
     def contains(self, x: np.ndarray) -> np.ndarray:
         lo, hi = np.asarray(self.lo), np.asarray(self.hi)
         return np.all((x >= lo) & (x <= hi), axis=1)
@@ -69,9 +73,18 @@ class VelocityPulse:
         positive(self, path, "half_width")
         below_light(self, path, "velocity")
 
+    region_key = ""
+
+    @property
+    def what(self) -> str:
+        return (f"the pulse's slab |{self.axis} - {self.center:g}| < {self.half_width:g} m")
+
+    def selects(self, x: np.ndarray) -> np.ndarray:
+        return np.abs(x[:, AXES[self.axis]] - self.center) < self.half_width
+
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         s = x[:, AXES[self.axis]] - self.center
-        inside = np.abs(s) < self.half_width
+        inside = self.selects(x)
         shape = np.cos(0.5 * np.pi * s[inside] / self.half_width) ** 2
         v[inside] += shape[:, None] * np.asarray(self.velocity)[None, :]
 
@@ -83,11 +96,20 @@ class UniformVelocity:
     region: Region
     velocity: tuple[float, float, float]
 
+    region_key = "region"
+
+    @property
+    def what(self) -> str:
+        return self.region.what
+
     def check(self, path):
         below_light(self, path, "velocity")
 
+    def selects(self, x: np.ndarray) -> np.ndarray:
+        return self.region.contains(x)
+
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
-        v[self.region.contains(x)] += np.asarray(self.velocity)
+        v[self.selects(x)] += np.asarray(self.velocity)
 
 
 @INITIAL.register("gaussian_velocity")
@@ -125,11 +147,22 @@ class RadialVelocity:
             fail(join(path, "r_outer"), "must exceed r_inner")
         below_light(self, path, "speed")
 
+    region_key = ""
+
+    @property
+    def what(self) -> str:
+        return (f"the ring {self.r_inner:g} <= r <= {self.r_outer:g} m about "
+                f"({self.center[0]:g}, {self.center[1]:g})")
+
+    def selects(self, x: np.ndarray) -> np.ndarray:
+        r = np.hypot(x[:, 0] - self.center[0], x[:, 1] - self.center[1])
+        return (r >= self.r_inner) & (r <= self.r_outer) & (r > 0)
+
     def apply(self, x: np.ndarray, v: np.ndarray) -> None:
         dx = x[:, 0] - self.center[0]
         dy = x[:, 1] - self.center[1]
         r = np.hypot(dx, dy)
-        sel = (r >= self.r_inner) & (r <= self.r_outer) & (r > 0)
+        sel = self.selects(x)
         v[sel, 0] += self.speed * dx[sel] / r[sel]
         v[sel, 1] += self.speed * dy[sel] / r[sel]
 
@@ -139,9 +172,16 @@ class RadialVelocity:
 class Fixed:
     """Points inside ``region`` are held at their reference position (u = v = 0)."""
     region: Region
+    region_key = "region"
+
+    @property
+    def what(self) -> str:
+        return self.region.what
 
     def mask(self, x: np.ndarray) -> np.ndarray:
         return self.region.contains(x)
+
+    selects = mask
 
 
 #: a face of an axis-aligned boundary: (axis, outward sign)
@@ -185,9 +225,20 @@ class Absorbing:
         """The damping coefficient (1/s) at the face for a material of P-wave speed c_p."""
         return 3.0 * c_p * np.log(1.0 / self.reflection) / self.thickness
 
+    region_key = ""
+
+    @property
+    def what(self) -> str:
+        return f"the layer {self.thickness:g} m inside {self.face} = {self.at:g} m"
+
     def mask(self, x: np.ndarray) -> np.ndarray:
         """No point is held fixed."""
         return np.zeros(len(x), dtype=bool)
+
+    def selects(self, x: np.ndarray) -> np.ndarray:
+        """The points the layer damps (c > 0)."""
+        axis, sign = FACES[self.face]
+        return self.thickness - sign * (self.at - x[:, axis]) > 0.0
 
     def damping(self, x: np.ndarray, c_p: np.ndarray) -> np.ndarray:
         """c (1/s) at points x of P-wave speed c_p: c_max (s/L)^2 inside the layer
@@ -196,6 +247,27 @@ class Absorbing:
         s = self.thickness - sign * (self.at - x[:, axis])
         frac = np.clip(s / self.thickness, 0.0, 1.0)
         return np.where(s > 0.0, self.c_max(c_p) * frac ** 2, 0.0)
+
+
+def regions(scene) -> list[tuple[str, object]]:
+    """(key, condition) of every initial and boundary condition that acts on a part of
+    the body (those with ``selects(x)``: a region, a slab, a ring, a layer), each of
+    which must hold a point (:func:`refuse_empty`; a gaussian_velocity acts everywhere)."""
+    return [(join(f"{kind}[{i}]", c.region_key) if c.region_key else f"{kind}[{i}]", c)
+            for kind, conds in (("initial", scene.initial), ("boundaries", scene.boundaries))
+            for i, c in enumerate(conds) if hasattr(c, "selects")]
+
+
+def refuse_empty(scene, counts) -> None:
+    """Bad input (SceneError naming the first such condition's key): a condition of
+    :func:`regions` that selects none of the body's points, given ``counts``, the points
+    each selects over the whole model (mpipd.solver.Simulation counts them over the
+    ranks, mpipd.check over the lattice: one rule)."""
+    for (key, c), n in zip(regions(scene), counts):
+        if n == 0:
+            kind = getattr(c, "registry_name", type(c).__name__)
+            fail(key, f"{c.what} holds no point of the body: this {kind!r} condition "
+                      "would act on nothing")
 
 
 @dataclass

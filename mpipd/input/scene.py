@@ -208,11 +208,15 @@ class Initiation:
     position x' is lit at time + |x' - point| / vod (a charge along any axis,
     :class:`mpipd.input.geometry.Rod`).  mpipd.model.gas.lighting_times.  A
     charge without one follows its material's initiation_z and direction at
-    time 0."""
+    time 0.  ``never = true``: a charge that is not lit at all (unlit gas all run,
+    e.g. a thrown charge); without it, a charge none of whose points is lit before
+    the run's end, or whose plane or point lies outside it, is bad input
+    (mpipd.model.gas.check_charges)."""
     z: float = 0.0
     time: float = 0.0
     direction: float = 1.0
     point: tuple[float, float, float] | None = None
+    never: bool = False
 
     def check(self, path):
         non_negative(self, path, "time")
@@ -220,9 +224,16 @@ class Initiation:
             fail(join(path, "direction"), "must be 1 or -1")
         if self.point is not None and (self.z != 0.0 or self.direction != 1.0):
             fail(join(path, "point"), "give either point or z and direction, not both")
+        if self.never and (self.point is not None or self.z != 0.0 or self.time != 0.0
+                           or self.direction != 1.0):
+            fail(join(path, "never"), "a charge that is never lit takes no z, time, "
+                                      "direction or point")
 
     def times(self, x, vod):
-        """Lighting times of reference positions ``x`` (n, 3) (class docstring)."""
+        """Lighting times of reference positions ``x`` (n, 3) (class docstring;
+        infinite for a charge that is never lit)."""
+        if self.never:
+            return np.full(len(x), np.inf)
         if self.point is not None:
             return self.time + np.linalg.norm(x - np.asarray(self.point), axis=1) / vod
         return self.time + (x[:, 2] - self.z) * self.direction / vod

@@ -17,6 +17,16 @@ Because every per-point dataset is indexed by gid and broken bonds by gid
 pairs, a checkpoint written by N ranks restarts on M ranks, and the continued
 run is bit-identical to the uninterrupted one (tests/test_restart.py).
 
+Every checkpoint carries checksums (attribute ``checksums``, JSON: one per
+``points/<name>`` dataset, one for ``broken`` and one for the step, time and
+scalar attributes; mpipd.kernels.hashrng.row_checksum, a sum over gid-keyed rows,
+so the same on any number of ranks), computed from the arrays as they are
+written and verified on restart: a checkpoint changed after it was written
+(finite garbage the non-finite test cannot see) is refused with one line
+(CheckpointError, exit 2) instead of running on from it and blaming dt later.  A
+checkpoint written before the checksums (none stored) is restored with a warning
+in the run log that its data are not verified.
+
 Files are written collectively (h5py ``mpio``) to ``<name>.tmp`` and renamed
 by rank 0 once complete, so a checkpoint on disk is never half written.  Before
 any of it is written, rank 0 compares the checkpoint's data size with the space
@@ -35,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..kernels.hashrng import row_checksum
 from ..state import LAST, REBUILT, STATE
 from .pairs import rows_between
 
@@ -43,6 +54,39 @@ FORMAT = "mpipd-checkpoint-1"
 
 class CheckpointError(ValueError):
     """A checkpoint file that cannot be used (missing, malformed, other scene)."""
+
+
+#: the attribute holding the checksums, and what they are
+CHECKSUMS = "checksums"
+CHECKSUM_KIND = "mpipd.kernels.hashrng.row_checksum by gid (points/*), by gid_i (broken)"
+
+
+def _salt(name: str) -> int:
+    import hashlib
+    return int.from_bytes(hashlib.blake2b(name.encode(), digest_size=8).digest(), "little")
+
+
+def _attr_token(v) -> str:
+    """A scalar attribute as the checksum sees it (exact: ints as ints, floats in hex)."""
+    return (str(int(v)) if np.issubdtype(np.asarray(v).dtype, np.integer)
+            else float(v).hex())
+
+
+def _checksums(team, data: dict, g0: int, pairs: np.ndarray, attrs: dict) -> dict:
+    """Checksums (hex) of the whole checkpoint from this rank's rows (collective):
+    ``data`` (name -> owned rows, gids g0...), its broken ``pairs`` and the
+    scalar ``attrs`` (the same on every rank)."""
+    mine = {f"points/{name}": row_checksum(arr, np.arange(g0, g0 + len(arr)),
+                                           _salt(f"points/{name}"))
+            for name, arr in data.items()}
+    mine["broken"] = row_checksum(pairs, pairs[:, 0] if len(pairs) else np.empty(0),
+                                  _salt("broken"))
+    parts = team.gather(mine)
+    out = {k: f"{sum(p[k] for p in parts) % 2 ** 64:016x}" for k in mine}
+    tokens = np.array([_salt(f"{k}={_attr_token(attrs[k])}") for k in sorted(attrs)],
+                      np.uint64)
+    out["attrs"] = f"{row_checksum(tokens, np.arange(len(tokens)), _salt('attrs')):016x}"
+    return out
 
 
 def _per_point(sim) -> dict:
@@ -118,12 +162,16 @@ def _write(sim, tmp, scene_text, overrides, run_id):
         a["t"] = sim.t
         a["n_points"] = N
         a["ranks"] = team.size
+        checked = {"step": sim.step_count, "t": sim.t}
         for s in sim.state.scalars.values():    # loads' work, ledger sums, broken bonds
-            a[s.name] = ({"sum": team.sum, "max": team.max}[s.reduce](s.get())
-                         if s.reduce in ("sum", "max") else s.get())
+            a[s.name] = checked[s.name] = ({"sum": team.sum, "max": team.max}[s.reduce](s.get())
+                                           if s.reduce in ("sum", "max") else s.get())
         if sim.probes is not None:                # the running peaks, whole run
             a["probe_peaks"] = json.dumps(sim.probes.peaks())
-        for name, arr in _per_point(sim).items():
+        data = _per_point(sim)
+        a[CHECKSUMS] = json.dumps(_checksums(team, data, g0, pairs, checked))
+        a["checksum_kind"] = CHECKSUM_KIND
+        for name, arr in data.items():
             d = f.create_dataset(f"points/{name}", (N,) + arr.shape[1:], arr.dtype)
             with d.collective:
                 d[g0:g1] = arr
@@ -243,8 +291,10 @@ class Checkpointer:
         self.written_step = self.sim.step_count
 
 
-def restore(sim, path) -> None:
-    """Load a checkpoint into a freshly built Simulation of the same scene."""
+def restore(sim, path) -> str | None:
+    """Load a checkpoint into a freshly built Simulation of the same scene; a
+    checkpoint whose data do not match its checksums is refused (CheckpointError).
+    Returns a warning for the run log (a checkpoint without checksums), else None."""
     import h5py
     team = sim.team
     g0, g1 = sim.gid_range
@@ -265,12 +315,31 @@ def restore(sim, path) -> None:
             v = f.attrs[name]
             scalars[name] = int(v) if np.issubdtype(np.asarray(v).dtype, np.integer) else float(v)
         probe_peaks = json.loads(str(f.attrs["probe_peaks"])) if "probe_peaks" in f.attrs else {}
+        try:
+            stored = json.loads(str(f.attrs[CHECKSUMS])) if CHECKSUMS in f.attrs else None
+        except ValueError:
+            stored = {}
     bad = [name for name, arr in data.items()
            if arr.dtype.kind == "f" and not np.all(np.isfinite(arr))]
     bad = sorted(set().union(*team.gather(set(bad))))
     if bad or not all(np.isfinite(v) for v in (t, *scalars.values())):
         raise CheckpointError(f"{path}: non-finite values in " + (", ".join(bad) or "attributes")
                               + " (a corrupted checkpoint, or one written by a blow-up)")
+    note = None
+    if stored is None:
+        note = (f"{path} carries no checksums (written by an mpipd before they were "
+                "added): its data are restored unverified")
+    else:
+        now = _checksums(team, data, g0, mine, {"step": step, "t": t, **scalars})
+        wrong = [k for k in now if stored.get(k) != now[k]]
+        if wrong:
+            raise CheckpointError(f"{path}: {', '.join(wrong[:3])}"
+                                  + (f" and {len(wrong) - 3} more" if len(wrong) > 3 else "")
+                                  + (" does not match the checksum written with it"
+                                     if len(wrong) == 1 else
+                                     " do not match the checksums written with them")
+                                  + " (the file changed after it was written: a corrupted "
+                                  "checkpoint)")
     st = sim.state
     for fld in st.checkpointed(STATE):                  # 1. the state
         fld.load(data[fld.name])
@@ -290,3 +359,4 @@ def restore(sim, path) -> None:
     sim.initialize()                                    # 4. F and forces
     for fld in st.checkpointed(LAST):                   # 5. the last step's values
         fld.load(data[fld.name])
+    return note

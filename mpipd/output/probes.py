@@ -74,6 +74,42 @@ def part_matches(part: str, name: str) -> bool:
     return name == part or name.startswith(part + ".")
 
 
+def nearest(pr, part_names, x, gid, part, material, dx, horizon) -> tuple:
+    """The candidate point of probe ``pr`` among the points ``x`` (with their gid,
+    part index, material id, dx and horizon): (distance, gid, x, part, material, dx,
+    horizon) of the nearest point of its part (any point if it names none), or
+    (inf, -1) if there is none.  The min of the candidates of every piece of the
+    model is the probe's point (lowest gid on a tie).  Probes (the run, on each
+    rank's owned points) and mpipd.check (the lattice, layer by layer) both use it."""
+    n = len(x)
+    d = np.linalg.norm(x - np.asarray(pr.position), axis=1) if n else np.empty(0)
+    if pr.part is not None and n:
+        ok = np.array([part_matches(pr.part, q) for q in part_names], bool)
+        d = np.where(ok[part], d, np.inf)
+    if not n or not np.isfinite(d).any():
+        return (math.inf, -1)
+    j = int(np.argmin(d))          # the first minimum: the lowest gid of a piece in gid order
+    return (float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
+            int(material[j]), float(dx[j]), float(horizon[j]))
+
+
+def placed(k, pr, found) -> str | None:
+    """Judge probe ``k``'s point ``found`` (the min of :func:`nearest` over the
+    model): bad input (SceneError) if its part has no point or the point is farther
+    than its horizon (outside the body); the run log's warning (:func:`snap_note`)
+    if it moved more than SNAP_WARN dx; else None."""
+    if not math.isfinite(found[0]):
+        fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
+    dist, _, xg, _, _, dxg, hg = found
+    if dist > hg:
+        fail(f"probes[{k}].position", f"probe {pr.name!r}: the nearest point"
+             f"{' of part ' + repr(pr.part) if pr.part else ''} is {dist * 1e3:.3g} mm "
+             f"away, beyond its horizon ({hg * 1e3:.3g} mm): outside the body?")
+    if dist > SNAP_WARN * dxg:     # more than half a lattice spacing: say so
+        return snap_note(pr.name, pr.position, xg, dist, dxg)
+    return None
+
+
 class Probes:
     def __init__(self, probes, scene, points, team, corr, v, mode, klass, gas=None):
         """``probes``: the scene's; ``corr``: the correspondence model (stress of a
@@ -98,25 +134,12 @@ class Probes:
         self.gid, self.x, self.dist, self.part, self.material = [], [], [], [], []
         self.dx = []                        # dx of each chosen point's part
         for k, pr in enumerate(self.probes):
-            d = np.linalg.norm(x - np.asarray(pr.position), axis=1) if n else np.empty(0)
-            if pr.part is not None:
-                ok = np.array([part_matches(pr.part, q) for q in parts], bool)
-                d = np.where(ok[part], d, np.inf)
-            j = int(np.argmin(d)) if n else -1
-            best = ((float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
-                     int(mat[j]), float(points.dx[j]), float(points.horizon[j]))
-                    if n and np.isfinite(d[j]) else (math.inf, -1))
+            best = nearest(pr, parts, x, gid, part, mat, points.dx[:n], points.horizon[:n])
             found = min(team.gather(best))
-            key = f"probes[{k}].position"
-            if not math.isfinite(found[0]):
-                fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
+            note = placed(k, pr, found)
+            if note:
+                self.notes.append(note)
             dist, g, xg, pg, mg, dxg, hg = found
-            if dist > hg:
-                fail(key, f"probe {pr.name!r}: the nearest point"
-                     f"{' of part ' + repr(pr.part) if pr.part else ''} is {dist * 1e3:.3g} mm "
-                     f"away, beyond its horizon ({hg * 1e3:.3g} mm): outside the body?")
-            if dist > SNAP_WARN * dxg:     # more than half a lattice spacing: say so
-                self.notes.append(snap_note(pr.name, pr.position, xg, dist, dxg))
             self.gid.append(g)
             self.dx.append(dxg)
             self.x.append(xg)
