@@ -179,3 +179,51 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "long" in item.keywords:
             item.add_marker(skip)
+
+
+# ------------------------------------------------------------------ shared by several test modules
+#: built-in scenes reduced to seconds; together they build every model (blast_demo
+#: with step classes: multi-rate's arrays are state too)
+SCENES = [
+    ("elastic_wave", ["parts.0.dx=0.004"]),
+    ("granite_ring", ["parts.0.dx=0.002"]),
+    ("detonation_tube", ["parts.2.shape.radius=0.005"]),
+    ("blast_demo", ["parts.0.shape.z=[0.0, 0.003]", "parts.1.shape.z=[0.0, 0.003]",
+                    "parts.2.shape.z=[0.0, 0.003]", "parts.2.shape.radius=0.012",
+                    "time.t_end=4e-7", "probes=[]",
+                    'output.fields=["u","peak_pressure","peak_speed","pressure","damage"]',
+                    "time.multirate={ max_ratio = 4, safety = 0.5 }"]),
+]
+
+
+def check_bad(res, out, *needles, mpirun=False):
+    assert res.returncode == 2, res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    if mpirun:                       # mpirun adds its own banner around ours
+        lines = [ln for ln in lines if ln.startswith("mpipd")]
+    assert len(lines) == 1, res.stderr
+    assert lines[0].startswith("mpipd: error: ")
+    for n in needles:
+        assert n in lines[0], lines[0]
+    assert not out.exists()
+
+
+def free_charge(dt_factor=0.3, steps=200, radius=0.002, length=0.006, dx=5e-4):
+    """A free JWL charge (a cylinder of the paper's explosive), dt at dt_factor of the stable step."""
+    d = {"scene": {"name": "free_charge"},
+         "time": {"dt": 1e-9, "steps": steps},
+         "materials": {"explosive": {"model": "jwl", "damping": 0.0}},
+         "parts": [{"name": "charge", "material": "explosive", "dx": dx,
+                    "shape": {"kind": "cylinder", "center": [0, 0], "radius": radius,
+                              "z": [0.0, length]}}]}
+    from mpipd.check import critical_dt
+    d["time"]["dt"] = dt_factor * critical_dt(make_scene(d))
+    return make_scene(d)
+
+
+def closure_without(e, term) -> float:
+    """|balance| if ``term`` were not booked."""
+    from mpipd.model.ledger import DISSIPATED, HELD
+    held = e.held - (getattr(e, term) if term in HELD else 0.0)
+    diss = e.dissipated - (getattr(e, term) if term in DISSIPATED else 0.0)
+    return abs(e.initial + e.external - held - diss) / e.scale

@@ -5,7 +5,7 @@ import re
 from pathlib import Path
 
 import pytest
-from test_state import SCENES
+from conftest import SCENES
 
 from mpipd.input import scene as sc
 from mpipd.solver import Simulation

@@ -1,8 +1,7 @@
 """Several charges with their own initiation, and a box with boreholes (issue 19)."""
 import numpy as np
 import pytest
-from conftest import run_cli
-from test_scene_errors import check_bad
+from conftest import check_bad, run_cli
 
 from mpipd.input import scene as sc
 from mpipd.model.gas import lighting_times

@@ -5,23 +5,13 @@ discretisation error; each case states the bound it is held to (measured
 values in the comments, from the commit that added this file).  Leaving one
 term out must break the bound: the check can fail.
 """
-import sys
 
 import pytest
-from conftest import ROOT
+from conftest import closure_without
 
 from mpipd.input import scene as sc
-from mpipd.model.ledger import DISSIPATED, HELD, impossible
+from mpipd.model.ledger import impossible
 from mpipd.solver import Simulation
-
-sys.path.insert(0, str(ROOT / "tests"))
-
-
-def closure_without(e, term) -> float:
-    """|balance| if ``term`` were not booked."""
-    held = e.held - (getattr(e, term) if term in HELD else 0.0)
-    diss = e.dissipated - (getattr(e, term) if term in DISSIPATED else 0.0)
-    return abs(e.initial + e.external - held - diss) / e.scale
 
 
 def run(scene, every=10):
@@ -84,7 +74,7 @@ def test_without_the_refresh_the_breakage_error_shows(impact):
 
 
 def test_free_gas_charge_closes_to_round_off():
-    from test_stability import free_charge
+    from conftest import free_charge
     scene = free_charge(dt_factor=0.5, steps=120)
     sim, e, worst = run(scene)
     assert e.kinetic > 0.5 * e.initial                   # most of the charge's energy moved

@@ -25,3 +25,12 @@ def test_mpi_marker_follows_mpirun():
     report = {t for t in mpi if t.startswith("tests/test_report.py")}
     assert "tests/test_report.py::test_report_on_blast_demo_under_mpirun" in report
     assert len(report) < len(collected("tests/test_report.py"))
+
+
+def test_no_test_module_imports_another():
+    """Shared helpers live in conftest.py (or a helper module), never in a test module
+    that another imports."""
+    import re
+    for path in HERE.glob("test_*.py"):
+        text = path.read_text()
+        assert not re.search(r"^\s*(from|import)\s+test_\w+", text, re.M), path.name

@@ -6,9 +6,8 @@ import math
 
 import numpy as np
 import pytest
-from conftest import make_scene, run_cli, scene_dict
+from conftest import check_bad, make_scene, run_cli, scene_dict
 from scipy import stats
-from test_scene_errors import check_bad
 
 from mpipd.input.schema import build
 from mpipd.materials.heterogeneity import DISTRIBUTIONS

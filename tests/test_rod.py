@@ -6,8 +6,7 @@ import sys
 import h5py
 import numpy as np
 import pytest
-from conftest import child_env, restart_matches, run_cli
-from test_scene_errors import check_bad
+from conftest import check_bad, child_env, restart_matches, run_cli
 
 from mpipd.input import scene as sc
 from mpipd.input.geometry import Annulus, Box, Cylinder, Hole, Rod, part_points

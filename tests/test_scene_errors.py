@@ -1,6 +1,6 @@
 """Bad input: one clear line naming what is wrong, exit status 2, nothing written."""
 import pytest
-from conftest import run_cli
+from conftest import check_bad, run_cli
 
 from mpipd.input import scene as sc
 
@@ -17,18 +17,6 @@ CASES = [
     (["--set", "initial.0.axis=w"], "initial[0].axis", "must be one of"),
     (["--set", "time.dt=true"], "time.dt", "expected a number"),
 ]
-
-
-def check_bad(res, out, *needles, mpirun=False):
-    assert res.returncode == 2, res.stderr
-    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
-    if mpirun:                       # mpirun adds its own banner around ours
-        lines = [ln for ln in lines if ln.startswith("mpipd")]
-    assert len(lines) == 1, res.stderr
-    assert lines[0].startswith("mpipd: error: ")
-    for n in needles:
-        assert n in lines[0], lines[0]
-    assert not out.exists()
 
 
 @pytest.mark.parametrize("args,key,reason", CASES)

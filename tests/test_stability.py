@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import make_scene, run_cli
+from conftest import free_charge, make_scene, run_cli
 
 from mpipd.check import check_report, critical_dt
 from mpipd.materials.jh2 import JH2
@@ -356,17 +356,6 @@ def test_jwl_at_the_unreacted_density_and_at_huge_expansion():
     assert 0 < g.isentrope_pressure(1e6, C) < 1e-3 * cj["p"]
 
 
-def free_charge(dt_factor=0.3, steps=200, radius=0.002, length=0.006, dx=5e-4):
-    d = {"scene": {"name": "free_charge"},
-         "time": {"dt": 1e-9, "steps": steps},
-         "materials": {"explosive": {"model": "jwl", "damping": 0.0}},
-         "parts": [{"name": "charge", "material": "explosive", "dx": dx,
-                    "shape": {"kind": "cylinder", "center": [0, 0], "radius": radius,
-                              "z": [0.0, length]}}]}
-    d["time"]["dt"] = dt_factor * critical_dt(make_scene(d))
-    return make_scene(d)
-
-
 def expand_freely(team, dt_factor):
     scene = free_charge(dt_factor=dt_factor, steps=int(round(60 / dt_factor)))
     sim = Simulation(scene, team)
@@ -601,7 +590,7 @@ def test_blast_at_the_paper_rock_resolution_stays_physical(blast_08):
 
 
 def test_blast_ledger_closes(blast_08):
-    from test_ledger import closure_without
+    from conftest import closure_without
     sim, e, worst, _ = blast_08
     assert worst < 1e-4                                  # 1.2e-5, 1.8e-5 single-rate; 1.1e-5, 1.7e-5 at ratio 4
     assert e.gas_damping > 0 and e.plastic > 0 and e.kinetic > 0.3 * e.initial

@@ -4,6 +4,7 @@ with its owner, every checkpointed field round-trips through a checkpoint, the
 ambiguous registrations."""
 import numpy as np
 import pytest
+from conftest import SCENES
 
 from mpipd.input import scene as sc
 from mpipd.output import checkpoint as ck
@@ -11,18 +12,6 @@ from mpipd.parallel.halo import Halo
 from mpipd.solver import Simulation
 from mpipd.state import LOCAL, OWNED, State
 
-#: built-in scenes reduced to seconds; together they build every model (blast_demo
-#: with step classes: multi-rate's arrays are state too)
-SCENES = [
-    ("elastic_wave", ["parts.0.dx=0.004"]),
-    ("granite_ring", ["parts.0.dx=0.002"]),
-    ("detonation_tube", ["parts.2.shape.radius=0.005"]),
-    ("blast_demo", ["parts.0.shape.z=[0.0, 0.003]", "parts.1.shape.z=[0.0, 0.003]",
-                    "parts.2.shape.z=[0.0, 0.003]", "parts.2.shape.radius=0.012",
-                    "time.t_end=4e-7", "probes=[]",
-                    'output.fields=["u","peak_pressure","peak_speed","pressure","damage"]',
-                    "time.multirate={ max_ratio = 4, safety = 0.5 }"]),
-]
 #: arrays a Simulation holds that are not per-point state: the decomposition's
 #: layer table and slab bounds (a few numbers per z level)
 NOT_STATE = ("sim.slabs.",)
