@@ -12,11 +12,13 @@ closer in x-y than sqrt(R^2 - dz^2) — counted with 2-D KD trees and cached per
 total-Lagrangian bonds; its current-configuration families are re-found every
 step and are not counted.
 
-Stable time step.  Two estimates per part, and the scene's dt against the smaller
+Stable time step (mpipd.model.stability, which ``mpipd run`` and the multi-rate
+classes read too).  Two estimates per part, and the scene's dt against the smaller
 (``mpipd run`` refuses a dt above it unless ``--force``):
 
 * Silling & Askari (2005), bond-based bound for a bulk point:
-  dt_c = sqrt(2 rho / sum_j V_j c / |xi_j|), c = 18 K / (pi delta^4);
+  dt_c = sqrt(2 rho / sum_j V_j c / |xi_j|), c = 18 K / (pi delta^4)
+  (``stability.stable_dt``, ``stability.micromodulus``);
 * the P-wave transit of one lattice spacing, dx / sqrt((K + 4G/3) / rho).
 
 Both assume the reference moduli, i.e. the wave speed c_p of the material at
@@ -41,6 +43,10 @@ from scipy.spatial import cKDTree
 from .input.geometry import LayerTable, fill_layers, part_points
 from .input.loads import refuse_empty, regions
 from .model.gas import check_charges, lighting_times
+
+# the stable-step estimates live in mpipd.model.stability; part_critical_dt is
+# named here too for a release (its old home)
+from .model.stability import bulk_family, critical_dt, part_critical_dt, stable_dt  # noqa: F401
 from .parallel.decomp import decompose, halo_width, replicated_parts
 
 #: memory model, bytes — kept equal to the arrays :class:`mpipd.solver.Simulation`
@@ -111,39 +117,6 @@ def memory_model(scene) -> tuple[int, int]:
                 local += MULTIRATE_ROW_SUM_LOCAL
                 owned += MULTIRATE_ROW_SUM_OWNED
     return local, owned
-
-
-def bulk_family(dx: float, horizon: float) -> np.ndarray:
-    """Bond lengths |xi| of a bulk lattice point's family."""
-    n = int(math.ceil(horizon / dx))
-    k = np.arange(-n, n + 1)
-    kx, ky, kz = np.meshgrid(k, k, k, indexing="ij")
-    r = dx * np.sqrt(kx * kx + ky * ky + kz * kz).ravel()
-    return r[(r > 0) & (r < horizon)]
-
-
-def stable_dt(part, material) -> tuple[float, float]:
-    """(Silling–Askari dt, dx / c_p) for a bulk point of ``part``:
-    dt_c = sqrt(2 rho / sum_j V_j c / |xi_j|), c = 18 K / (pi delta^4), V_j = dx^3 over
-    the bulk family, and c_p = ``material.p_wave_speed`` (sqrt((K + 4G/3) / rho); the
-    detonation speed of a JWL explosive)."""
-    r = bulk_family(part.dx, part.horizon)
-    c = 18.0 * material.bulk_modulus / (math.pi * part.horizon ** 4)
-    dt_sa = math.sqrt(2.0 * material.density / np.sum(part.dx ** 3 * c / r))
-    return dt_sa, part.dx / material.p_wave_speed
-
-
-def part_critical_dt(scene) -> np.ndarray:
-    """Each part's stable-step estimate min(dt_c, dx / c_p) (:func:`stable_dt`), by part
-    index: the critical step of a bulk point of the part at rest."""
-    return np.array([min(stable_dt(q, scene.materials[q.material])) for q in scene.parts])
-
-
-def critical_dt(scene) -> float:
-    """The stable-step estimate ``mpipd run`` holds dt to (and ``mpipd check`` reports,
-    benchmarks.verify_case scales): dt_max = min over parts of min(dt_c, dx / c_p)
-    (:func:`part_critical_dt`)."""
-    return float(part_critical_dt(scene).min())
 
 
 def layer_bonds(scene, table) -> np.ndarray:

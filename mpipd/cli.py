@@ -148,11 +148,11 @@ def _bad_input(team, exc) -> int:
 
 
 def _run(args, team, signals=None) -> int:
-    from .check import critical_dt
     from .input import scene as sc
     from .input.geometry import check_parts
     from .input.schema import SceneError
     from .model.gas import check_charges
+    from .model.stability import critical_dt
     from .output import checkpoint as ck
     from .output import rundir
     from .parallel.decomp import DecompositionError

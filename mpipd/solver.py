@@ -29,7 +29,6 @@ import time as _time
 
 import numpy as np
 
-from .check import part_critical_dt
 from .input.geometry import LayerTable
 from .input.joints import cut_joints
 from .input.loads import refuse_empty, regions
@@ -44,6 +43,7 @@ from .model.interface import InterfaceCorrection
 from .model.interface import needed as interface_needed
 from .model.ledger import Energies, Ledger, impossible
 from .model.multirate import StepClasses
+from .model.stability import part_critical_dt
 from .output.peaks import Peaks
 from .output.probes import Probes
 from .parallel.decomp import decompose, halo_width, local_points, replicated_parts
@@ -65,7 +65,7 @@ class Simulation:
         self.scene = scene
         self.team = team
         self.dt = scene.time.dt
-        self.dt_stable = float(part_critical_dt(scene).min())    # mpipd.check.critical_dt
+        self.dt_stable = float(part_critical_dt(scene).min())    # stability.critical_dt
         table = LayerTable.from_parts(scene.parts, scene.material_ids)
         gas_parts = scene.gas_parts
         # the gas is held whole on every rank (the solids it acts on: mpipd.parallel.near)

@@ -216,7 +216,7 @@ def free_charge(dt_factor=0.3, steps=200, radius=0.002, length=0.006, dx=5e-4):
          "parts": [{"name": "charge", "material": "explosive", "dx": dx,
                     "shape": {"kind": "cylinder", "center": [0, 0], "radius": radius,
                               "z": [0.0, length]}}]}
-    from mpipd.check import critical_dt
+    from mpipd.model.stability import critical_dt
     d["time"]["dt"] = dt_factor * critical_dt(make_scene(d))
     return make_scene(d)
 

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from conftest import make_scene, run_cli
 
-from mpipd.check import check_report, critical_dt, layer_bonds
+from mpipd.check import check_report, layer_bonds
 from mpipd.input import scene as sc
 from mpipd.input.geometry import LayerTable
+from mpipd.model.stability import critical_dt
 from mpipd.solver import Simulation
 
 BUILTIN = sorted(sc.builtin_scenes())

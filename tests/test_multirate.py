@@ -339,7 +339,7 @@ def test_a_failures_line_keeps_the_smallest_step_up_to_the_last_frame_apart():
 def bar_at_rest_ratio(r0, ratio, factor="row_sum", more=""):
     """The bar with classes from the state (safety 1, family factor ``factor``, further
     multirate keys ``more``) and dt set so that every point's ratio at rest is ``r0``."""
-    from mpipd.check import stable_dt
+    from mpipd.model.stability import stable_dt
     probe = sc.load("elastic_wave", BAR + ["time.dt=1e-8", "time.t_end=1.6e-6"])[0]
     dt = min(stable_dt(probe.parts[0], probe.materials[probe.parts[0].material])) / r0
     scene, _ = sc.load("elastic_wave", BAR + [f"time.dt={dt}", f"time.t_end={80 * dt}",
@@ -521,7 +521,7 @@ def _crushed_block(factor, held=None, share=0.95, n_side=12, stable_floor=False)
     velocities; classes from the rule (``family_factor``), or held at ``held``."""
     from conftest import make_scene
 
-    from mpipd.check import critical_dt
+    from mpipd.model.stability import critical_dt
     dx = 8e-4
     L = n_side * dx
     d = {"scene": {"name": "crushed"}, "time": {"dt": 1e-9, "steps": 800},

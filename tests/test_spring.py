@@ -29,8 +29,8 @@ def _reduced_family(dt_fraction):
     """An 9^3 granite block whose centre point keeps only its bonds in the plane z = 0
     and the one to (0, 0, +dx): K stays invertible (det K passes the RCOND test) but its
     z eigenvalue has lost most of its reference value.  ``dt_fraction``: dt over the
-    critical step the fallback rule compares with (mpipd.check.part_critical_dt)."""
-    from mpipd.check import part_critical_dt
+    critical step the fallback rule compares with (mpipd.model.stability.part_critical_dt)."""
+    from mpipd.model.stability import part_critical_dt
     dx = 1e-3
     d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [9 * dx] * 3}, dx=dx)
     dtc = part_critical_dt(make_scene(d))[0]
@@ -98,7 +98,7 @@ def test_stable_floor_never_exceeds_the_reference_eigenvalue(team):
 def _jointed_block(frac):
     """A 10^3 granite block (dx 1 mm, never failing) cut by two joints, x = 4.3 mm and
     y = 4.3 mm, into four columns; dt = ``frac`` of the critical step."""
-    from mpipd.check import part_critical_dt
+    from mpipd.model.stability import part_critical_dt
     d = scene_dict({"kind": "box", "lo": [0, 0, 0], "hi": [10e-3] * 3}, dx=1e-3)
     d["materials"]["granite"]["tension"] = {"sigma_st": -1e15}
     d["joints"] = [{"point": [4.3e-3, 0, 0], "normal": [1.0, 0, 0]},
@@ -114,7 +114,7 @@ def test_a_face_cut_by_a_joint_starts_on_its_correspondence_force(team):
     springs, although the points along the joints, measured against their whole family
     (the rule before), lie below (0.95)^2 of it; lambda_min of both families computed
     here with numpy."""
-    from mpipd.check import part_critical_dt
+    from mpipd.model.stability import part_critical_dt
     frac = 0.95
     sim = Simulation(_jointed_block(frac), team)
     p, fam = sim.points, sim.families

@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 from conftest import free_charge, make_scene, run_cli
 
-from mpipd.check import check_report, critical_dt
+from mpipd.check import check_report
 from mpipd.materials.jh2 import JH2
 from mpipd.materials.jwl import JWL
 from mpipd.materials.tension import dynamic_strength
+from mpipd.model.stability import critical_dt
 from mpipd.solver import Simulation, Unstable
 
 

@@ -21,7 +21,7 @@ def build_scene(d):
 
 def stable_step(scene) -> float:
     """The step `mpipd run` accepts at most (the Silling-Askari / CFL estimate)."""
-    from mpipd.check import critical_dt
+    from mpipd.model.stability import critical_dt
     return critical_dt(scene)
 
 

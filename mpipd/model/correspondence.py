@@ -25,8 +25,6 @@ The explosive's points ("ul" family) are rows here too (code NOT_TL in
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..kernels import energy, integrate, nosb, rotation
@@ -35,6 +33,7 @@ from ..kernels.viscosity import viscosity_data
 from ..materials.base import STATE_OUTPUTS
 from ..state import AUX, BOND, LAST, LOCAL, REBUILT
 from .base import Model
+from .stability import micromodulus
 
 #: a point whose det K <= RCOND (tr K / 3)^3 uses the bond-spring fallback
 RCOND = 1e-8
@@ -48,7 +47,7 @@ def stable_floor(lam0: np.ndarray, dt_ratio: np.ndarray) -> np.ndarray:
     from ``lam0`` = lambda_min(K_i^0) over the point's family at the start of the run
     (its reference family less the bonds that start broken: joints) and ``dt_ratio``
     = dt / dt_c,i, dt the finest step (every step class's) and dt_c,i the critical step
-    of the point's part at rest (mpipd.check.part_critical_dt).
+    of the point's part at rest (mpipd.model.stability.part_critical_dt).
 
     Point i's force state is omega P K^-1 xi with P linear in F = N K^-1, so the
     largest eigenvalue of its element's stiffness grows as 1 / lambda_min(K_i), and
@@ -204,7 +203,7 @@ class Correspondence(Model):
             points.material[:n]]
         # bond-spring constant 18 k / (pi delta^4) of every local point
         bulk = np.array([m.bulk_modulus for m in mats])[points.material]
-        self.cbb = 18.0 * bulk / (math.pi * points.horizon ** 4)
+        self.cbb = micromodulus(bulk, points.horizon)
         self.n_spring = 0
         # points outside the total-Lagrangian model (the gas): code NOT_TL, never counted
         self.not_tl = np.flatnonzero(~tl[:n]) if tl is not None else np.zeros(0, np.int64)

@@ -33,7 +33,7 @@ Class rule (at every coarse boundary, identical on any number of ranks: a
 function of each point's own state, then of its family by halo exchange):
 
     dt_i = dt_c,i * lambda_i * kappa_i * c_p,i / c_i(state)   (the stable step now;
-                                                          dt_c,i: mpipd.check.stable_dt
+                                                          dt_c,i: stability.stable_dt
                                                           of the point's part; c_p,i its
                                                           reference P-wave speed)
     r_i  = safety * dt_i / dt
@@ -206,7 +206,7 @@ class StepClasses:
         #: each owned point's critical step, P-wave speed at rest and coarsening margin
         self.dtc = self.cp0 = self.hyst = None
         if self.enabled:
-            from ..check import part_critical_dt
+            from .stability import part_critical_dt
             cp = np.array([scene.materials[q.material].p_wave_speed for q in scene.parts])
             self.dtc = part_critical_dt(scene)[points.part[:n]]
             self.cp0 = cp[points.part[:n]]

@@ -10,7 +10,7 @@ middle, two crossed cracks, and a central ball (radius L/4) with 30-95 % of its 
 broken (a hash of the pair: the same bonds both ways).  For each, the smallest factor
 over the block of each rule (``mpipd.model.multirate.FAMILY_FACTORS``), and the
 critical step measured single-rate: white-noise velocities, 600 steps at dt = f dt_c
-(dt_c: ``mpipd.check.critical_dt``), stable if the total energy stays within 1 % and
+(dt_c: ``mpipd.model.stability.critical_dt``), stable if the total energy stays within 1 % and
 no runaway is detected; f bisected between 0.05 and 2.2 to 1/32 of the bracket.
 The margin of a rule: the measured critical step over the largest step the class rule
 gives the cut block's worst point at blast_paper's safety 0.5 (0.5 x factor x dt_c;
@@ -41,9 +41,9 @@ SAFETY = 0.5
 
 def scene(side: int, f: float):
     """The block at dt = f dt_c; and dt_c."""
-    from mpipd.check import critical_dt
     from mpipd.input.scene import Scene
     from mpipd.input.schema import build
+    from mpipd.model.stability import critical_dt
     L = side * DX
     d = {"scene": {"name": "family_factor"}, "time": {"dt": 1e-9, "steps": STEPS},
          "materials": {"granite": {"model": "jh2"}},
