@@ -25,6 +25,9 @@ does not depend on the number of ranks that wrote it::
                             set is rows offsets[k]:offsets[k + 1] (sorted by gid_lo);
                             only in a scene that can fail or has joints
     /bonds/offsets          (n_frames + 1,) int64
+    /xdmf/vertices          (N,) int64: the gids 0 .. N-1, the connectivity of run.xdmf's
+                            Polyvertex (one vertex cell a point); written once, at the
+                            first close
     attrs peak_gas_pressure, density_at_lighting (JSON: per charge, the largest and
                             mean density when lit, x the charge's, and the fraction lit)
 
@@ -33,9 +36,11 @@ Each rank owns one contiguous gid range and writes it as one hyperslab.
 ``run.xdmf`` beside the file (written by rank 0 when the writer closes, so at the
 end of a run, of a ``--stop-after`` and of a restart, for the frames written so
 far) opens every field at every frame in ParaView: one Uniform grid a frame in a
-temporal collection, the points as a Polyvertex on ``/geometry/x`` (gid order),
-each field a selection of frame k of ``/fields/<name>``, spelled so that all three
-of ParaView 5.11's XDMF readers load it (``XDMFReader``, ``Xdmf3ReaderS``,
+temporal collection, the points on ``/geometry/x`` (gid order) each a vertex cell (a
+Polyvertex of N one-point elements whose connectivity is ``/xdmf/vertices``: without
+it the Xdmf 3 readers give no cells, and nothing draws, thresholds or clips), each
+field a selection of frame k of ``/fields/<name>``, spelled so that all three of
+ParaView 5.11's XDMF readers load it (``XDMFReader``, ``Xdmf3ReaderS``,
 ``Xdmf3ReaderT``; see ``_xdmf_field_item``).
 """
 from __future__ import annotations
@@ -43,6 +48,7 @@ from __future__ import annotations
 import json
 import subprocess
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -270,6 +276,7 @@ class Writer:
             segs = json.loads(old if isinstance(old, str) else old.decode())
             segs.append({**segment, "git_commit": self.commit})
             self.f.attrs["segments"] = json.dumps(segs)
+        self._vertices()
         self.f.attrs["frames_written"] = self.frames_written
         self.f.attrs["bonds_broken"] = self.sim.bonds_broken()
         self.f.attrs["failed_points_by_mode"] = self.sim.failure_counts()
@@ -281,8 +288,22 @@ class Writer:
         self.f.close()
         if self.sim.team.root:
             times, geometry = self.time_values()
+            scene = self.sim.scene
+            parts = [{"name": q.name, "material": q.material,
+                      "gas": q.material in scene.gas_materials} for q in scene.parts]
             write_xdmf(self.path, self.sim.n_global, self.fields, self.frames_written,
-                       times, self.n_frames, geometry)
+                       times, self.n_frames, geometry, parts)
+
+    def _vertices(self):
+        """``/xdmf/vertices``, the gids 0 .. N-1: the connectivity of the Polyvertex
+        in run.xdmf (``write_xdmf``).  Written once, collectively, each rank its gid
+        range like the geometry; a close that finds it (a restart's) writes nothing,
+        and a file from before it gets it at its restart's close."""
+        if "xdmf/vertices" in self.f:
+            return
+        g0, g1 = self.sim.gid_range
+        d = self.f.require_group("xdmf").create_dataset("vertices", (self.sim.n_global,), "i8")
+        self._write(d, np.s_[g0:g1], np.arange(g0, g1, dtype=np.int64))
 
     @property
     def frames_written(self) -> int:
@@ -342,25 +363,42 @@ def _xdmf_field_item(h5: str, name: str, k: int, shape, column: int | None = Non
 
 
 def write_xdmf(h5path: Path, N: int, fields, frames: int, times, n_alloc: int | None = None,
-               geometry: dict | None = None) -> Path:
+               geometry: dict | None = None, parts: list | None = None) -> Path:
     """An XDMF file next to ``h5path`` describing frames ``0 .. frames-1`` as point clouds.
+
+    The points of a frame are a Polyvertex of ``N`` one-point elements, point ``i`` the
+    element ``i``, with its connectivity ``/xdmf/vertices`` (``Writer._vertices``).
+    ParaView's Xdmf 3 readers (``Xdmf3ReaderS``, the one ``OpenDataFile`` picks, and
+    ``Xdmf3ReaderT``) make cells only from a topology's connectivity: without it they
+    gave the points and no cell, so Surface and Points drew nothing and Threshold, Clip
+    and Slice gave nothing.  Now all three readers give N vertex cells (libxdmf2's
+    ``XDMFReader`` did without).  An inline XML index array would do on a small run, but
+    libxml2 refuses a text node over 10 MB (about 1.2 M points) and every frame would
+    carry it; the HDF5 dataset is written once.
 
     ``n_alloc`` is the length of the fields' frame axis in the file (the frames the
     run was sized for, default ``frames``): a run stopped early has written fewer.
     Each frame's fields are selections of ``/fields/<name>``, readable by all three
     of ParaView's XDMF readers (see ``_xdmf_field_item``); the HDF5 layout is the
     one the rest of mpipd reads.  ``geometry``: the per-point datasets of
-    ``/geometry`` (name -> "Int" or "Float"), each an attribute of every frame."""
+    ``/geometry`` (name -> "Int" or "Float"), each an attribute of every frame.
+    ``parts``: per part index, its ``name``, ``material`` and whether it is an
+    explosive's ``gas``, as JSON in the Domain's ``<Information Name="parts">``
+    (which the readers skip; scripts/paraview_figure.py hides the gas with it)."""
     h5 = h5path.name
     out = h5path.with_suffix(".xdmf")
     n_alloc = frames if n_alloc is None else n_alloc
-    lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "<Domain>",
-             '<Grid Name="run" GridType="Collection" CollectionType="Temporal">']
+    lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "<Domain>"]
+    if parts is not None:
+        lines.append(f'<Information Name="parts" Value={quoteattr(json.dumps(parts))}/>')
+    lines.append('<Grid Name="run" GridType="Collection" CollectionType="Temporal">')
     for k in range(frames):
         lines += [f'<Grid Name="frame{k}" GridType="Uniform">',
                   f'<Time Value="{times[k]:.9e}"/>',
                   f'<Topology TopologyType="Polyvertex" NumberOfElements="{N}" '
-                  'NodesPerElement="1"/>',
+                  'NodesPerElement="1">',
+                  f'<DataItem Dimensions="{N}" NumberType="Int" Precision="8" '
+                  f'Format="HDF">{h5}:/xdmf/vertices</DataItem>', "</Topology>",
                   '<Geometry GeometryType="XYZ">',
                   f'<DataItem Dimensions="{N} 3" NumberType="Float" Precision="8" '
                   f'Format="HDF">{h5}:/geometry/x</DataItem>', "</Geometry>"]
