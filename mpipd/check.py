@@ -279,10 +279,10 @@ def lattice_checks(scene, table) -> list[str]:
     (mpipd.input.geometry.fill_layers, the lattice the run makes, jitter included),
     a few million at a time: every initial or boundary region holds a point
     (mpipd.input.loads.refuse_empty) and every probe's point is within its horizon
-    (mpipd.output.probes.nearest and placed).  The same rules on the same points:
+    (mpipd.input.probes.nearest and placed).  The same rules on the same points:
     ``mpipd check`` refuses what ``mpipd run`` refuses (SceneError).  Returns the
     report's lines on the probes (the point each samples; a snap warning)."""
-    from .output.probes import nearest, placed
+    from .input.probes import nearest, placed
     conds = regions(scene)
     if not conds and not scene.probes:
         return []

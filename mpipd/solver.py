@@ -32,6 +32,7 @@ import numpy as np
 from .input.geometry import LayerTable
 from .input.joints import cut_joints
 from .input.loads import refuse_empty, regions
+from .input.probes import place
 from .kernels import integrate, runaway
 from .kernels.layout import N_MODES, SPRING_K
 from .model.base import Model
@@ -181,8 +182,9 @@ class Simulation:
         self.peaks.register(st)
         self.classify()                         # the reference state's classes
         self.initialize()
-        self.probes = (Probes(scene.probes, scene, p, team, self.corr, self.v, self.mode,
-                              self.classes.klass, gas=self.gas) if scene.probes else None)
+        self.probes = (Probes(scene.probes, place(scene.probes, scene, p, team), self.dt, p,
+                              team, self.corr, self.v, self.mode, self.classes.klass,
+                              gas=self.gas) if scene.probes else None)
         self.energies()                         # the ledger's initial energy (step 0)
 
     def initialize(self):

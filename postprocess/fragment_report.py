@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from mpipd.input.probes import part_matches
 from mpipd.input.scene import parse
 from mpipd.output.pairs import rows_between
-from mpipd.output.probes import part_matches
 from mpipd.parallel.team import Team
 
 from .fragments import Fragments, sizes

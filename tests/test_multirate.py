@@ -9,7 +9,8 @@ import pytest
 
 from mpipd.input import scene as sc
 from mpipd.input.schema import SceneError
-from mpipd.model.multirate import level_at, projected_cost, steps_since_update
+from mpipd.kernels.classes import level_at, steps_since_update
+from mpipd.model.multirate import projected_cost
 from mpipd.solver import Simulation, Unstable
 
 BAR = ["parts.0.shape.hi=[0.096, 0.006, 0.006]", "output.every=8"]

@@ -6,8 +6,8 @@ import pytest
 from conftest import granite, make_scene, scene_dict
 
 from mpipd.input import scene as sc
+from mpipd.input.probes import part_matches
 from mpipd.input.schema import SceneError
-from mpipd.output.probes import part_matches
 from mpipd.solver import Simulation
 
 L = 0.0048

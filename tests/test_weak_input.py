@@ -19,7 +19,7 @@ OUTSIDE = 'probes=[{name="far", position=[5.0, 0.0, 0.0], part="bar"}]'
 
 def test_check_refuses_a_probe_outside_the_body_with_runs_line(tmp_path):
     """The issue's probe 4.8 m from the bar: `check` gives the same line as `run`
-    (one rule, mpipd.output.probes.placed, on the same points), and lists the point
+    (one rule, mpipd.input.probes.placed, on the same points), and lists the point
     of a probe inside it."""
     out = tmp_path / "p"
     ran = one_error(run_cli(["run", "elastic_wave", "--out", str(out), *SMALL,

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..kernels.hashrng import STREAM_JOINT
 from ..kernels.joints import cut_bonds
-from ..output.probes import part_matches
+from .probes import part_matches
 from .schema import fail, join, non_negative
 
 

@@ -48,10 +48,10 @@ import tomllib
 
 from ..kernels.influence import CODES as INFLUENCE
 from ..materials import MATERIALS
-from ..output.probes import Probe, part_matches
 from .geometry import SHAPES
 from .joints import Joint
 from .loads import BOUNDARIES, INITIAL, LOADS, Absorbing
+from .probes import Probe, part_matches
 from .schema import SceneError, build, fail, join, non_negative, positive, tagged
 
 HORIZON_TOL = 1e-3

@@ -19,6 +19,24 @@ from .layout import CORRESPONDENCE, INTACT
 from .linalg import principal_max_min
 
 
+def level_at(step: int, ratio: int) -> int:
+    """The level of the force evaluation at the end of step ``step`` (the states of
+    classes k <= level act there): the 2-adic valuation of the step within the
+    coarse interval, log2(ratio) at a coarse boundary."""
+    top = ratio.bit_length() - 1
+    s = step % ratio
+    if s == 0:
+        return top
+    return (s & -s).bit_length() - 1
+
+
+def steps_since_update(step: int, k: int) -> int:
+    """Fine steps since a class-k point's state was last updated, at the end of step
+    ``step``: class k is updated at the steps that are multiples of 2^k (the same
+    schedule as :func:`level_at`: level_at(step) >= k exactly there)."""
+    return step % (1 << k)
+
+
 @numba.njit(cache=True, inline="always")
 def weight(k, level):
     """2^k if a class-k state acts at a force evaluation of ``level``, else 0.0."""

@@ -111,30 +111,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.classes import around, element_sums, family_min, largest_eigenvalue, min_stretch, row_sums
+from ..kernels.classes import around, element_sums, family_min, largest_eigenvalue, level_at, min_stretch, row_sums
 from ..kernels.layout import CORRESPONDENCE, INTACT, NOT_TL, SPRING_F
 from ..state import AUX, LOCAL
 
 #: coarsening needs the class's margin times this (refinement: 1)
 HYSTERESIS = 1.25
-
-
-def level_at(step: int, ratio: int) -> int:
-    """The level of the force evaluation at the end of step ``step`` (the states of
-    classes k <= level act there): the 2-adic valuation of the step within the
-    coarse interval, log2(ratio) at a coarse boundary."""
-    top = ratio.bit_length() - 1
-    s = step % ratio
-    if s == 0:
-        return top
-    return (s & -s).bit_length() - 1
-
-
-def steps_since_update(step: int, k: int) -> int:
-    """Fine steps since a class-k point's state was last updated, at the end of step
-    ``step``: class k is updated at the steps that are multiples of 2^k (the same
-    schedule as :func:`level_at`: level_at(step) >= k exactly there)."""
-    return step % (1 << k)
 
 
 class StepClasses:

@@ -1,16 +1,9 @@
 """Probes: named points whose state is recorded every step (paper Figs. 15–16).
 
-Each probe is the lattice point nearest its ``position`` (lowest gid on a tie),
-among the points of its ``part`` if it names one (a probe farther than that
-point's horizon from it is refused as outside the body; one moved by more
-than half the dx of the point's part, in 3-D distance from the requested
-position, is a warning in the run log naming the probe, the requested and the
-snapped positions and the distance: it samples the material elsewhere than asked,
-e.g. blast_paper's P1, asked 0.8 mm from the wall, sits 0.42 mm from it, 0.57 mm
-from its position; paper Fig. 15) (a part name matches the part
-and its zones ``<part>.band``, ``<part>.0``, ... of :meth:`mpipd.input.scene.Part.zones`,
-so ``part = "rock"`` samples the rock whatever its resolution bands); the rank
-that owns it records, every step,
+Where a probe sits (the lattice point nearest its position, among the points of
+its part; refused outside the body, a warning when moved more than dx/2) is the
+scene's side, mpipd.input.probes; the solver places them and hands the
+placement here.  The rank that owns a probe's point records, every step,
 
     t, sigma_rr, v_r            radial stress and velocity about the axis through ``center``
     p                           pressure -tr(sigma)/3 (compression positive)
@@ -37,115 +30,35 @@ Rows are kept in memory between frames and written by the owner at each frame.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from ..input.schema import fail
+from ..kernels.classes import steps_since_update
 from ..kernels.layout import GD_P
-from ..model.multirate import steps_since_update
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength", "t_state")
-#: a snap farther than this many dx of the point's part is a warning in the run log
-SNAP_WARN = 0.5
-
-
-@dataclass(frozen=True)
-class Probe:
-    """``name``, ``position`` (m), ``center`` (x, y) of the radial axis (default 0, 0),
-    ``part``: the part whose points it may snap to (default: any point)."""
-    name: str
-    position: tuple[float, float, float]
-    center: tuple[float, float] = (0.0, 0.0)
-    part: str | None = None
-
-
-def snap_note(name, position, x, dist, dx) -> str:
-    """The run log's warning for a probe moved more than ``SNAP_WARN`` dx by its snap."""
-    def at(p):
-        return "(" + ", ".join(f"{float(c) * 1e3:.4g}" for c in p) + ") mm"
-    return (f"probe {name!r} moved {dist * 1e3:.3g} mm (more than dx/2 = {SNAP_WARN * dx * 1e3:.3g} "
-            f"mm of its part) from the requested position {at(position)} to the nearest point "
-            f"{at(x)}")
-
-
-def part_matches(part: str, name: str) -> bool:
-    """Does the scene part (or zone) ``name`` belong to the probe's ``part``?"""
-    return name == part or name.startswith(part + ".")
-
-
-def nearest(pr, part_names, x, gid, part, material, dx, horizon) -> tuple:
-    """The candidate point of probe ``pr`` among the points ``x`` (with their gid,
-    part index, material id, dx and horizon): (distance, gid, x, part, material, dx,
-    horizon) of the nearest point of its part (any point if it names none), or
-    (inf, -1) if there is none.  The min of the candidates of every piece of the
-    model is the probe's point (lowest gid on a tie).  Probes (the run, on each
-    rank's owned points) and mpipd.check (the lattice, layer by layer) both use it."""
-    n = len(x)
-    d = np.linalg.norm(x - np.asarray(pr.position), axis=1) if n else np.empty(0)
-    if pr.part is not None and n:
-        ok = np.array([part_matches(pr.part, q) for q in part_names], bool)
-        d = np.where(ok[part], d, np.inf)
-    if not n or not np.isfinite(d).any():
-        return (math.inf, -1)
-    j = int(np.argmin(d))          # the first minimum: the lowest gid of a piece in gid order
-    return (float(d[j]), int(gid[j]), tuple(map(float, x[j])), int(part[j]),
-            int(material[j]), float(dx[j]), float(horizon[j]))
-
-
-def placed(k, pr, found) -> str | None:
-    """Judge probe ``k``'s point ``found`` (the min of :func:`nearest` over the
-    model): bad input (SceneError) if its part has no point or the point is farther
-    than its horizon (outside the body); the run log's warning (:func:`snap_note`)
-    if it moved more than SNAP_WARN dx; else None."""
-    if not math.isfinite(found[0]):
-        fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
-    dist, _, xg, _, _, dxg, hg = found
-    if dist > hg:
-        fail(f"probes[{k}].position", f"probe {pr.name!r}: the nearest point"
-             f"{' of part ' + repr(pr.part) if pr.part else ''} is {dist * 1e3:.3g} mm "
-             f"away, beyond its horizon ({hg * 1e3:.3g} mm): outside the body?")
-    if dist > SNAP_WARN * dxg:     # more than half a lattice spacing: say so
-        return snap_note(pr.name, pr.position, xg, dist, dxg)
-    return None
 
 
 class Probes:
-    def __init__(self, probes, scene, points, team, corr, v, mode, klass, gas=None):
-        """``probes``: the scene's; ``corr``: the correspondence model (stress of a
-        point, material groups); ``v``, ``mode`` and ``klass``: the State's velocities,
-        failure flags and step classes; ``gas``: the gas model (mpipd.model.gas.Gas),
-        if the scene has one (the pressure of a gas point).  Collective (the nearest
-        point is found over all ranks)."""
+    def __init__(self, probes, where, dt, points, team, corr, v, mode, klass, gas=None):
+        """``probes``: the scene's; ``where``: their points
+        (mpipd.input.probes.Placement); ``dt``: the fine step; ``corr``: the
+        correspondence model (stress of a point, material groups); ``v``, ``mode``
+        and ``klass``: the State's velocities, failure flags and step classes;
+        ``gas``: the gas model (mpipd.model.gas.Gas), if the scene has one (the
+        pressure of a gas point)."""
         self.probes = list(probes)
         self.gas = gas
         self.team, self.corr, self.v, self.mode = team, corr, v, mode
-        self.klass, self.dt = klass, scene.time.dt
+        self.klass, self.dt = klass, dt
         self.points = points
-        n = points.n_owned
-        x = points.x[:n]
-        gid = points.gid[:n]
-        part = points.part[:n]
-        mat = points.material[:n]
-        parts = [q.name for q in scene.parts]
-        self.part_names, self.material_names = parts, list(scene.materials)
+        gid = points.gid[:points.n_owned]
+        self.notes = list(where.notes)      # warnings for the run log
+        self.gid, self.x, self.dist = list(where.gid), list(where.x), list(where.dist)
+        self.part, self.material = list(where.part), list(where.material)
+        self.dx = list(where.dx)            # dx of each chosen point's part
         self.mine = []                      # (probe index, local index)
-        self.notes = []                     # warnings for the run log
-        self.gid, self.x, self.dist, self.part, self.material = [], [], [], [], []
-        self.dx = []                        # dx of each chosen point's part
-        for k, pr in enumerate(self.probes):
-            best = nearest(pr, parts, x, gid, part, mat, points.dx[:n], points.horizon[:n])
-            found = min(team.gather(best))
-            note = placed(k, pr, found)
-            if note:
-                self.notes.append(note)
-            dist, g, xg, pg, mg, dxg, hg = found
-            self.gid.append(g)
-            self.dx.append(dxg)
-            self.x.append(xg)
-            self.dist.append(dist)
-            self.part.append(parts[pg])
-            self.material.append(self.material_names[mg])
+        for k, g in enumerate(self.gid):
             local = np.flatnonzero(gid == g)
             if len(local):
                 self.mine.append((k, int(local[0])))
