@@ -261,9 +261,7 @@ class Simulation:
         self.halo.exchange(self.v)              # v_{n+1} on the ghosts too (as _refresh_forces)
         rows = self.classes.reweighted_rows()
         self.corr.reweight(rows, self.u, self.v, self.f, self.ledger.fv, self.classes.previous)
-        a = self.f[rows] * (1.0 / self.rho[rows])[:, None]          # as integrate.kick
-        a[self.fixed[rows].astype(bool)] = 0.0
-        self.a[rows] = a
+        integrate.accelerations(self.f, self.rho, self.fixed, rows, self.a)
         self.ledger.start(self.interface)
         self.ledger.reclass += before - self.ledger.integrator(self)
 

@@ -56,6 +56,15 @@ from .schema import SceneError, build, fail, join, non_negative, positive, tagge
 
 HORIZON_TOL = 1e-3
 
+
+def check_horizon_factor(obj, path):
+    """A horizon delta = horizon_factor * dx * (1 + HORIZON_TOL) of at least dx:
+    horizon_factor >= 1 (NaN refused), the one check of a part's and an inner band's
+    ``horizon_factor`` (SceneError naming ``<path>.horizon_factor``)."""
+    if not obj.horizon_factor >= 1.0:
+        fail(join(path, "horizon_factor"),
+             f"horizon must be at least dx (factor >= 1, got {obj.horizon_factor})")
+
 #: per-point fields that ``[output] fields`` may name: components and what the scene needs
 OUTPUT_FIELDS = {
     "u": (3, None), "v": (3, None), "stress": (6, None),
@@ -194,8 +203,7 @@ class Band:
     def check(self, path):
         positive(self, path, "dx")
         positive(self, path, "width")
-        if not self.horizon_factor >= 1.0:
-            fail(join(path, "horizon_factor"), f"must be at least 1 (got {self.horizon_factor})")
+        check_horizon_factor(self, path)
 
 
 @dataclass(frozen=True)
@@ -262,9 +270,7 @@ class Part:
         if self.influence not in INFLUENCE:
             fail(join(path, "influence"), f"unknown influence function {self.influence!r} "
                                           f"(known: {', '.join(INFLUENCE)})")
-        if not self.horizon_factor >= 1.0:
-            fail(join(path, "horizon_factor"),
-                 f"horizon must be at least dx (factor >= 1, got {self.horizon_factor})")
+        check_horizon_factor(self, path)
         if self.grade is not None and not hasattr(self.shape, "radius"):
             fail(join(path, "grade"), "grading needs a cylinder or annulus shape")
         if self.band is not None:

@@ -28,6 +28,7 @@ import numba
 from .index import family, neighbour
 from .influence import influence
 from .layout import CORRESPONDENCE, NOT_TL
+from .linalg import normal_stress
 from .nosb import rest_length
 
 
@@ -109,7 +110,7 @@ def update_peaks(x, v, sigma, R, gas_idx, gas_p, cx, cy, peak_p, peak_srr, peak_
     """Running per-point peaks over the steps: pressure -tr(sigma)/3 (the JWL
     pressure ``gas_p`` at the gas points), -sigma_rr about the z axis through
     (cx, cy) (sigma = R sigma_unrot R^T, so sigma_rr = a . sigma_unrot . a with
-    a = R^T e_r), and |v|."""
+    a = R^T e_r, linalg.normal_stress), and |v|."""
     for i in range(sigma.shape[0]):
         s0, s1, s2 = sigma[i, 0], sigma[i, 1], sigma[i, 2]
         s3, s4, s5 = sigma[i, 3], sigma[i, 4], sigma[i, 5]
@@ -127,8 +128,7 @@ def update_peaks(x, v, sigma, R, gas_idx, gas_p, cx, cy, peak_p, peak_srr, peak_
             a0 = R[i, 0, 0] * c + R[i, 1, 0] * s
             a1 = R[i, 0, 1] * c + R[i, 1, 1] * s
             a2 = R[i, 0, 2] * c + R[i, 1, 2] * s
-            srr = (s0 * a0 * a0 + s1 * a1 * a1 + s2 * a2 * a2
-                   + 2.0 * (s3 * a1 * a2 + s4 * a0 * a2 + s5 * a0 * a1))
+            srr = normal_stress(s0, s1, s2, s3, s4, s5, a0, a1, a2)
             if -srr > peak_srr[i]:
                 peak_srr[i] = -srr
     for k in range(gas_idx.shape[0]):

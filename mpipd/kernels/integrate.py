@@ -47,19 +47,39 @@ def kick_drift(u, v, a, dt, fixed, damp, edamp):
             u[i, c] += dt * v[i, c]
 
 
+@numba.njit(cache=True, inline="always")
+def acceleration(f, rho, fixed, i, a):
+    """a_i = f_i / rho_i (f the force density, rho the density), a_i = 0 at a fixed
+    point; True if the point is free.  Newton's law of every kick, in one place."""
+    if fixed[i]:
+        for c in range(3):
+            a[i, c] = 0.0
+        return False
+    s = 1.0 / rho[i]
+    for c in range(3):
+        a[i, c] = f[i, c] * s
+    return True
+
+
+@numba.njit(cache=True)
+def accelerations(f, rho, fixed, rows, a):
+    """:func:`acceleration` at the owned ``rows`` only (the forces gathered again
+    there), without a kick."""
+    for i in rows:
+        acceleration(f, rho, fixed, i, a)
+
+
 @numba.njit(cache=True)
 def kick(v, f, rho, dt, fixed, a):
-    """a = f / rho; second half kick."""
+    """a = f / rho (:func:`acceleration`; v = 0 at a fixed point); second half kick
+    v += dt/2 a."""
     h = 0.5 * dt
     for i in range(a.shape[0]):
-        if fixed[i]:
+        if not acceleration(f, rho, fixed, i, a):
             for c in range(3):
-                a[i, c] = 0.0
                 v[i, c] = 0.0
             continue
-        s = 1.0 / rho[i]
         for c in range(3):
-            a[i, c] = f[i, c] * s
             v[i, c] += h * a[i, c]
 
 

@@ -79,6 +79,20 @@ def mat_to_voigt(m, out):
 
 
 @numba.njit(cache=True, inline="always")
+def normal_stress(s0, s1, s2, s3, s4, s5, a0, a1, a2):
+    """a . sigma . a, the normal stress on the plane of unit normal a, of sigma in Voigt
+    order (s0..s5 = xx, yy, zz, yz, xz, xy):
+
+        a . sigma . a = s0 a0^2 + s1 a1^2 + s2 a2^2 + 2 (s3 a1 a2 + s4 a0 a2 + s5 a0 a1)
+
+    With a = e_r, the radial unit vector about an axis along z, it is sigma_rr (the
+    running peak of kernels.energy.update_peaks, with a = R^T e_r on the unrotated
+    stress; the probes of mpipd.output.probes, with a = e_r on the Cauchy stress)."""
+    return (s0 * a0 * a0 + s1 * a1 * a1 + s2 * a2 * a2
+            + 2.0 * (s3 * a1 * a2 + s4 * a0 * a2 + s5 * a0 * a1))
+
+
+@numba.njit(cache=True, inline="always")
 def principal_max_min(a00, a11, a22, a12, a02, a01):
     """Largest and smallest eigenvalue of a symmetric 3x3 matrix, in closed form
     (Smith 1961, Commun. ACM 4(4) 168): with q = tr/3, p^2 = |a - qI|^2 / 6 and

@@ -6,6 +6,7 @@ scene's side, mpipd.input.probes; the solver places them and hands the
 placement here.  The rank that owns a probe's point records, every step,
 
     t, sigma_rr, v_r            radial stress and velocity about the axis through ``center``
+                                (sigma_rr = e_r . sigma . e_r, kernels.linalg.normal_stress)
     p                           pressure -tr(sigma)/3 (compression positive)
     s                           von Mises equivalent stress
                                 (a point of the explosive gas: its stress is the JWL
@@ -35,6 +36,7 @@ import numpy as np
 
 from ..kernels.classes import steps_since_update
 from ..kernels.layout import GD_P
+from ..kernels.linalg import normal_stress
 
 QUANTITIES = ("t", "sigma_rr", "v_r", "p", "s", "strength", "t_state")
 
@@ -93,7 +95,7 @@ class Probes:
             dx, dy = self.points.x[i, 0] - pr.center[0], self.points.x[i, 1] - pr.center[1]
             r = math.hypot(dx, dy) or 1.0
             c, sn = dx / r, dy / r
-            srr = s[0] * c * c + s[1] * sn * sn + 2 * s[5] * c * sn
+            srr = normal_stress(s[0], s[1], s[2], s[3], s[4], s[5], c, sn, 0.0)   # e_r . sigma . e_r
             vr = self.v[i, 0] * c + self.v[i, 1] * sn
             if self._is_gas(i):         # sigma = -p I: its p as it is, sigma_rr = -p, s = 0
                 p, srr, seq = -s[0], s[0], 0.0
