@@ -24,6 +24,7 @@ help:
 	@echo "make docs         the documentation site from docs/ into site/, strict"
 	@echo "make bench        throughput and memory of the kernels, beside LAMMPS"
 	@echo "make verify       error against run time of the verification problems, then make stability"
+	@echo "make examples     run the worked examples in examples/ and draw each (docs/img/examples)"
 	@echo "make lint         ruff"
 	@echo "make clean        remove caches (pytest, __pycache__, site/); never runs/"
 
