@@ -28,7 +28,9 @@ import os
 import shlex
 import socket
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from .kernels.layout import MODE_NAMES, N_MODES
 
@@ -246,8 +248,10 @@ def _run(args, team, signals=None) -> int:
                 rundir.clear_old_run(out)
         team.barrier()
         try:
-            return _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5,
-                           n_steps, dt_stable, run_id, resume, restored)
+            return RunIO(args=args, team=team, signals=signals, scene=scene, sim=sim,
+                         text=text, overrides=overrides, shown=shown, out=out, h5=h5,
+                         n_steps=n_steps, dt_stable=dt_stable, run_id=run_id, resume=resume,
+                         restored=restored).execute()
         except Exception as e:
             line = rundir.io_line(e, out)
             if line is None:
@@ -360,90 +364,141 @@ def _end_checkpoint(checkpointer, team, out) -> str | None:
     return next((e for e in team.gather(err) if e), None)
 
 
-def _over_dt(sim, team, scene, failed: bool = False) -> str | None:
-    """The multi-rate line on points whose stable step fell below dt in this
-    invocation (collective; None if none did, or single-rate; ``failed``: split at
-    the last frame, StepClasses.over_line)."""
-    return (sim.classes.over_line(team, list(scene.materials), failed)
-            if sim.classes.enabled else None)
+@dataclass
+class RunIO:
+    """One invocation of ``mpipd run`` past its checks: the command's ``args``, ``team``
+    and ``signals``; the ``scene``, its built Simulation ``sim``, the scene ``text``
+    and its --set ``overrides`` (``shown``: both as the run file stores them); the run
+    folder ``out`` and its run file ``h5``; the run length ``n_steps``, the stable
+    estimate ``dt_stable`` dt was checked against (mpipd.model.stability.critical_dt),
+    the run's id, whether it continues a run file (``resume``) and the restored
+    checkpoint's warning (``restored``).  ``log`` writes the run log (rank 0)."""
+    args: argparse.Namespace
+    team: Any
+    signals: Any
+    scene: Any
+    sim: Any
+    text: str
+    overrides: list
+    shown: str
+    out: Path
+    h5: Path
+    n_steps: int
+    dt_stable: float
+    run_id: str
+    resume: bool
+    restored: str | None = None
+    log: RunLog = field(init=False)
 
+    def __post_init__(self):
+        self.log = RunLog(self.out / "run.log", self.team)
 
-def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_steps,
-            dt_stable, run_id, resume, restored=None) -> int:
-    from .output import checkpoint as ck
-    from .output.writer import Writer
-    from .solver import Progress, Unstable
-    log = RunLog(out / "run.log", team)
-    what = f"restart at step {sim.step_count}, " if args.restart else ""
-    log(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
-        f"{team.size} rank(s), {n_steps} steps of {scene.time.dt:.3e} s -> {h5}")
-    if restored:                              # the checkpoint's own warning (no checksums)
-        log(f"mpipd: warning: {restored}")
-    if scene.time.dt > dt_stable:
-        log(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
-            f"{dt_stable:.4e} s (--force); the run may blow up")
-    n_spring = sim.spring_points()            # after the restore, on a restart
-    if n_spring:
-        n_soft = team.sum(sim.corr.count_floor())
-        log(f"mpipd: {n_spring} point(s) use the bond-spring fallback "
-            "(shape tensor not invertible" + (f", or, {n_soft} of them, invertible but too soft "
-                                              "for dt (on a restart: switched before the "
-                                              "checkpoint); mpipd.model.correspondence."
-                                              "stable_floor"
-                                              if n_soft else "") + ")")
-    for note in (sim.probes.notes if sim.probes is not None else ()):
-        log(f"mpipd: warning: {note}")
-    if sim.interface is not None:
-        full, planar, left = (team.sum(c) for c in sim.interface.counts)
-        log(f"mpipd: interface correction: {full} point(s) in full, {planar} in the x-y "
-            f"plane (near a z face); {left} keep their ghost force (an interface within "
-            "two horizons of an x-y free surface, or of a part that is no prism along z, "
-            "README)")
-    if sim.joint_bonds:
-        log(f"mpipd: joints: {sim.joint_bonds} bond(s) start broken (counted from both ends)")
-    writer = Writer(h5, sim, shown, n_steps, resume=resume, run_id=run_id)
-    progress = None if args.quiet else Progress(team, scene.solver.progress_every, log=log)
-    checkpointer = ck.Checkpointer(sim, out / "checkpoint.h5", text, overrides,
-                                   every=scene.output.checkpoint_every,
-                                   stop_after=args.stop_after, run_id=run_id)
-    checkpointer.install_signals(signals)
-    first = sim.step_count
-    wall = 0.0
+    def header(self):
+        """The run log's first lines: what runs, and the warnings of its set-up
+        (collective: the counts are summed over the ranks)."""
+        log, team, scene, sim = self.log, self.team, self.scene, self.sim
+        what = f"restart at step {sim.step_count}, " if self.args.restart else ""
+        log(f"mpipd: {scene.name}: {what}{sim.n_global} points, {sim.n_bonds_global} bonds, "
+            f"{team.size} rank(s), {self.n_steps} steps of {scene.time.dt:.3e} s -> {self.h5}")
+        if self.restored:                     # the checkpoint's own warning (no checksums)
+            log(f"mpipd: warning: {self.restored}")
+        if scene.time.dt > self.dt_stable:
+            log(f"mpipd: warning: dt = {scene.time.dt:.4e} s exceeds the stable estimate "
+                f"{self.dt_stable:.4e} s (--force); the run may blow up")
+        n_spring = sim.spring_points()        # after the restore, on a restart
+        if n_spring:
+            n_soft = team.sum(sim.corr.count_floor())
+            log(f"mpipd: {n_spring} point(s) use the bond-spring fallback "
+                "(shape tensor not invertible" + (f", or, {n_soft} of them, invertible but too "
+                                                  "soft for dt (on a restart: switched before "
+                                                  "the checkpoint); mpipd.model.correspondence."
+                                                  "stable_floor"
+                                                  if n_soft else "") + ")")
+        for note in (sim.probes.notes if sim.probes is not None else ()):
+            log(f"mpipd: warning: {note}")
+        if sim.interface is not None:
+            full, planar, left = (team.sum(c) for c in sim.interface.counts)
+            log(f"mpipd: interface correction: {full} point(s) in full, {planar} in the x-y "
+                f"plane (near a z face); {left} keep their ghost force (an interface within "
+                "two horizons of an x-y free surface, or of a part that is no prism along z, "
+                "README)")
+        if sim.joint_bonds:
+            log(f"mpipd: joints: {sim.joint_bonds} bond(s) start broken (counted from both ends)")
 
-    def segment():
+    def over_dt(self, failed: bool = False) -> str | None:
+        """The multi-rate line on points whose stable step fell below dt in this
+        invocation (collective; None if none did, or single-rate; ``failed``: split at
+        the last frame, StepClasses.over_line)."""
+        sim = self.sim
+        return (sim.classes.over_line(self.team, list(self.scene.materials), failed)
+                if sim.classes.enabled else None)
+
+    def segment(self, first: int, wall: float) -> dict:
         """This invocation's record (collective).  Every rank must write the same
         attribute: the loop's wall time is the slowest rank's (each rank's own
         differed, and ranks writing different strings corrupted ``segments``)."""
+        sim, team = self.sim, self.team
         done = sim.step_count - first
         w = team.max(wall)
         return {"from_step": first, "to_step": sim.step_count, "ranks": team.size,
                 "wall_s": round(w, 3),
                 "bond_steps_per_s": sim.n_bonds_global * done / w if w > 0 else None,
                 "bond_states_evaluated": round(sim.classes.evaluated_share(team), 4),
-                **({"restart_set": list(args.set)} if args.restart else {})}
-    try:
-        wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
-                       checkpointer=checkpointer)
-    except Unstable as e:
-        writer.close()
-        over = _over_dt(sim, team, scene, failed=True)
-        log(f"mpipd: error: {e}; state saved in {checkpointer.written}"
-            + (f"; {over}" if over else ""), error=True)
-        return EXIT_UNSTABLE
-    writer.close(segment())
-    end_error = (_end_checkpoint(checkpointer, team, out) if sim.step_count == n_steps
-                 else None)
-    if sim.step_count < n_steps:
-        # what this invocation saw of the stable step: the next one counts afresh
-        n_switched = team.sum(sim.corr.floor_switches)
-        over = _over_dt(sim, team, scene)
-        log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; {n_switched} stable-step "
-            "switch(es) from the correspondence force in this invocation "
-            f"(mpipd.model.correspondence.stable_floor); checkpoint {checkpointer.written}; "
-            f"continue with `mpipd run --restart {shlex.quote(str(checkpointer.written))}`")
-        if over:
-            log(f"mpipd: warning: {over}", error=True)
-        return 0
+                **({"restart_set": list(self.args.set)} if self.args.restart else {})}
+
+    def execute(self) -> int:
+        """Run the time loop with the run file, progress lines and checkpoints; the
+        exit status (0, or EXIT_UNSTABLE, or EXIT_IO for a finished run whose end
+        checkpoint failed) after the log's last lines (:func:`summary`)."""
+        from .output import checkpoint as ck
+        from .output.writer import Writer
+        from .solver import Progress, Unstable
+        args, team, scene, sim, log, n_steps = (self.args, self.team, self.scene, self.sim,
+                                                self.log, self.n_steps)
+        self.header()
+        writer = Writer(self.h5, sim, self.shown, n_steps, resume=self.resume,
+                        run_id=self.run_id)
+        progress = None if args.quiet else Progress(team, scene.solver.progress_every, log=log)
+        checkpointer = ck.Checkpointer(sim, self.out / "checkpoint.h5", self.text,
+                                       self.overrides, every=scene.output.checkpoint_every,
+                                       stop_after=args.stop_after, run_id=self.run_id)
+        checkpointer.install_signals(self.signals)
+        first = sim.step_count
+        wall = 0.0
+        try:
+            wall = sim.run(n_steps, writer=writer, every=scene.output.every, progress=progress,
+                           checkpointer=checkpointer)
+        except Unstable as e:
+            writer.close()
+            over = self.over_dt(failed=True)
+            log(f"mpipd: error: {e}; state saved in {checkpointer.written}"
+                + (f"; {over}" if over else ""), error=True)
+            return EXIT_UNSTABLE
+        writer.close(self.segment(first, wall))
+        end_error = (_end_checkpoint(checkpointer, team, self.out) if sim.step_count == n_steps
+                     else None)
+        if sim.step_count < n_steps:
+            # what this invocation saw of the stable step: the next one counts afresh
+            n_switched = team.sum(sim.corr.floor_switches)
+            over = self.over_dt()
+            log(f"mpipd: stopped at step {sim.step_count} of {n_steps}; {n_switched} "
+                "stable-step switch(es) from the correspondence force in this invocation "
+                f"(mpipd.model.correspondence.stable_floor); checkpoint {checkpointer.written}; "
+                f"continue with `mpipd run --restart {shlex.quote(str(checkpointer.written))}`")
+            if over:
+                log(f"mpipd: warning: {over}", error=True)
+            return 0
+        return summary(self, first, wall, checkpointer, end_error)
+
+
+def summary(run: RunIO, first: int, wall: float, checkpointer, end_error: str | None) -> int:
+    """The run log's last lines of a finished run (collective: sums over the ranks):
+    speed, fallback and failed points, step classes, the energy ledger, the gas and
+    the probes, the files written; EXIT_IO (after its line) if the end checkpoint
+    ``end_error`` was not written, else 0.  ``first``: the invocation's first step;
+    ``wall``: its loop's wall time (s)."""
+    from .model.ledger import impossible
+    log, team, sim, n_steps, h5 = run.log, run.team, run.sim, run.n_steps, run.h5
     n_spring = sim.spring_points()
     n_floor = team.sum(sim.corr.count_floor())
     n_switched = team.sum(sim.corr.floor_switches)
@@ -458,38 +513,21 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
            "invocation, mpipd.model.correspondence.stable_floor)"
            if n_floor or n_switched else ""))
     if sim.failure is not None:
-        log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}" for k in range(1, N_MODES))
+        log("mpipd: failed points: " + ", ".join(f"{failed[k]} {MODE_NAMES[k]}"
+                                                 for k in range(1, N_MODES))
             + f"; {broken} bonds broken")
     if sim.classes.enabled:
         log("mpipd: " + sim.classes.summary(team))
-        over = _over_dt(sim, team, scene)
+        over = run.over_dt()
         if over:
             log(f"mpipd: warning: {over}", error=True)
-    from .model.ledger import impossible
     e = sim.energies()
     log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "
         f"held {e.held:.6g} J + dissipated {e.dissipated:.6g} J; balance {e.balance:+.2e}")
     for msg in impossible(e):
         log(f"mpipd: warning: impossible energy: {msg}", error=True)
     if sim.gas is not None:
-        peak = team.max(sim.gas.peak_pressure)
-        m = sim.gas.mat
-        cj = m.chapman_jouguet()
-        log(f"mpipd: peak gas pressure {peak / 1e9:.3f} GPa (pressure_factor {m.pressure_factor:g}; "
-            f"Table 2 implies p_CJ = {cj['p'] / 1e9:.2f} GPa, D_CJ = {cj['D']:.0f} m/s; "
-            f"the paper reports up to 1.8 GPa)")
-        lit = sim.gas.lit_density(team)
-        log("mpipd: density at lighting (x the charge's): " + "; ".join(
-            f"{k} max {v['max']:.3f}, mean {v['mean']:.3f}"
-            + (f", {v['lit_fraction']:.0%} lit" if v["lit_fraction"] < 1 else "")
-            for k, v in lit.items()))
-        off, n_gas = (team.sum(int(sim.gas.n_singular)), team.sum(len(sim.gas.gas_idx)))
-        log(f"mpipd: gas points carrying no force at the end (no gas neighbourhood, "
-            f"mpipd.kernels.ul.well_posed, or a family collapsing in a step, "
-            f"MAX_VOLUME_STRAIN): {off} of {n_gas}")
-        log(f"mpipd: gas families searched {team.max(sim.gas.searches)} times in this "
-            f"invocation, {team.max(sim.gas.search_seconds):.1f} s on the slowest rank "
-            f"(mpipd.model.gas: Verlet skin tuned on the cost, {sim.gas.skin * 1e3:.3g} mm at the last search)")
+        _gas_summary(log, team, sim.gas)
     if sim.probes is not None:
         for name, (srr, vr, pmax) in sim.probes.peaks().items():
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "
@@ -504,6 +542,32 @@ def _run_io(args, team, signals, scene, sim, text, overrides, shown, out, h5, n_
             f"the run file {h5} is complete to step {n_steps}", error=True)
         return EXIT_IO
     return 0
+
+
+def _gas_summary(log, team, gas):
+    """The explosive's lines of the summary (collective): its peak pressure beside the
+    material's Chapman-Jouguet state and the paper's reported peak
+    (mpipd.materials.jwl.PAPER_PEAK_PRESSURE), the density at lighting, the points
+    carrying no force and the family searches."""
+    from .materials.jwl import PAPER_PEAK_PRESSURE
+    peak = team.max(gas.peak_pressure)
+    m = gas.mat
+    cj = m.chapman_jouguet()
+    log(f"mpipd: peak gas pressure {peak / 1e9:.3f} GPa (pressure_factor {m.pressure_factor:g}; "
+        f"Table 2 implies p_CJ = {cj['p'] / 1e9:.2f} GPa, D_CJ = {cj['D']:.0f} m/s; "
+        f"the paper reports up to {PAPER_PEAK_PRESSURE / 1e9:.1f} GPa)")
+    lit = gas.lit_density(team)
+    log("mpipd: density at lighting (x the charge's): " + "; ".join(
+        f"{k} max {v['max']:.3f}, mean {v['mean']:.3f}"
+        + (f", {v['lit_fraction']:.0%} lit" if v["lit_fraction"] < 1 else "")
+        for k, v in lit.items()))
+    off, n_gas = (team.sum(int(gas.n_singular)), team.sum(len(gas.gas_idx)))
+    log(f"mpipd: gas points carrying no force at the end (no gas neighbourhood, "
+        f"mpipd.kernels.ul.well_posed, or a family collapsing in a step, "
+        f"MAX_VOLUME_STRAIN): {off} of {n_gas}")
+    log(f"mpipd: gas families searched {team.max(gas.searches)} times in this "
+        f"invocation, {team.max(gas.search_seconds):.1f} s on the slowest rank "
+        f"(mpipd.model.gas: Verlet skin tuned on the cost, {gas.skin * 1e3:.3g} mm at the last search)")
 
 
 class RunLog:

@@ -11,8 +11,8 @@ Two rows are not bands of the paper's numbers.  The explosive's peak pressure is
 physical consistency check (``kind = "consistency"``): it must lie between the
 constant-volume explosion pressure p(1, e0) and the Chapman–Jouguet pressure, both
 computed from the run's own JWL constants (:mod:`postprocess.explosive`): the
-paper's "up to 1800 MPa" contradicts its Table 2 (p_CJ = 15.5 GPa), so it is shown
-but not judged.  The wall pressure, the peak-arrival wave speed and the direct
+paper's "up to 1800 MPa" (mpipd.materials.jwl.PAPER_PEAK_PRESSURE) contradicts its
+Table 2 (p_CJ = 15.5 GPa), so it is shown but not judged.  The wall pressure, the peak-arrival wave speed and the direct
 wave's peaks (the first pulse's, beside the judged whole-run peaks) are
 information only (``kind = "information"``, verdict "information").
 
@@ -33,6 +33,8 @@ impossible value: the verdict is "error: ...", and no number is shown).
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from mpipd.materials.jwl import PAPER_PEAK_PRESSURE
 
 
 @dataclass(frozen=True)
@@ -104,7 +106,7 @@ TARGETS = (
     Target("ppv_radius_2p5", "distance within which PPV > 2.5 m/s (Fig. 18)", "mm",
            "≈20 (text: '2500 m/s', read as mm/s)", "—", 15.0, 25.0, "20 ± 25 %"),
     Target("peak_gas_pressure", "peak explosive pressure, every step (Fig. 7)", "MPa",
-           "up to 1800", "—", None, None,
+           f"up to {PAPER_PEAK_PRESSURE / 1e6:.0f}", "—", None, None,
            "physical consistency: between p(1, e0) and p_CJ of the run's JWL constants",
            "consistency"),
     Target("peak_wall_pressure", "peak −σ_rr of the rock's wall layer, every step", "MPa",

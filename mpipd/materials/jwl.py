@@ -36,6 +36,11 @@ from ..input.schema import fail, join, non_negative, positive
 from ..kernels import eos
 from . import MATERIALS
 
+#: the peak gas pressure the paper reports (Pa; Fig. 7, "up to 1800 MPa"): below Table 2's
+#: own p(1, e0) and p_CJ (above), so a consistency row of the validation report
+#: (postprocess.targets), quoted by the run log beside the run's CJ state (mpipd.cli)
+PAPER_PEAK_PRESSURE = 1.8e9
+
 
 @dataclass(frozen=True)
 class BulkViscosity:
