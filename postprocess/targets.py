@@ -12,9 +12,10 @@ physical consistency check (``kind = "consistency"``): it must lie between the
 constant-volume explosion pressure p(1, e0) and the Chapman–Jouguet pressure, both
 computed from the run's own JWL constants (:mod:`postprocess.explosive`): the
 paper's "up to 1800 MPa" (mpipd.materials.jwl.PAPER_PEAK_PRESSURE) contradicts its
-Table 2 (p_CJ = 15.5 GPa), so it is shown but not judged.  The wall pressure, the peak-arrival wave speed and the direct
-wave's peaks (the first pulse's, beside the judged whole-run peaks) are
-information only (``kind = "information"``, verdict "information").
+Table 2 (p_CJ = 15.5 GPa), so it is shown but not judged.  The wall pressure, the
+peak-arrival wave speed and the direct wave's peaks (the first pulse's, beside the
+judged whole-run peaks) are information only (``kind = "information"``, verdict
+"information").
 
 The crack count and the crushed zone are judged by the paper's own measures: the
 major radial cracks on Fig. 11's sections linked as lattice neighbours
