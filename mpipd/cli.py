@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from .kernels.layout import MODE_NAMES, N_MODES
+from .parallel.team import Fatal
 
 EXIT_BAD_INPUT = 2
 EXIT_UNSTABLE = 3
@@ -41,6 +42,11 @@ EXIT_IO = 4          # a run's own file could not be written (disk full, read-on
 
 class UsageError(Exception):
     """Bad input that is not a scene key (output exists, too many ranks, …)."""
+
+
+class IOFailure(Fatal):
+    """Writing a run's own file failed (disk full, read-only, quota): one line, exit 4."""
+    exit_code = EXIT_IO
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -152,6 +158,7 @@ def _bad_input(team, exc) -> int:
 def _run(args, team, signals=None) -> int:
     from .input import scene as sc
     from .input.geometry import check_parts
+    from .input.restart import check_same_physics
     from .input.schema import SceneError
     from .model.gas import check_charges
     from .model.stability import critical_dt
@@ -175,7 +182,7 @@ def _run(args, team, signals=None) -> int:
             text = info.scene
             overrides = info.overrides + list(args.set)
             scene = sc.parse(text, str(args.restart), overrides)
-            rundir.check_same_physics(sc.parse(text, str(args.restart), info.overrides), scene)
+            check_same_physics(sc.parse(text, str(args.restart), info.overrides), scene)
             out = Path(args.out) if args.out else Path(args.restart).resolve().parent
         else:
             if not args.scene:
@@ -261,7 +268,7 @@ def _run(args, team, signals=None) -> int:
                     tmp.unlink()
                 except OSError:
                     pass
-            raise rundir.IOFailure(line) from None
+            raise IOFailure(line) from None
     finally:
         if lock is not None:
             lock.release()
