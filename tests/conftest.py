@@ -94,13 +94,28 @@ def one_error(res, *needles, code=2):
         assert n in line, line
     return line
 
+#: a terminal colour code: under mpirun a rank's stdout is a pseudo-terminal, and each
+#: rank of a run writes a colour reset (ESC[0m, no newline) to it near its end (not
+#: mpipd's code; the string is in llvmlite's LLVM library); mpirun may forward that
+#: fragment ahead of another rank's next line, which then no longer starts with
+#: "mpipd: " (test_restart's probe lines, seen under load)
+ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
+def _clean(res):
+    """``res`` with the colour codes taken out of stdout and stderr."""
+    res.stdout, res.stderr = ANSI.sub("", res.stdout or ""), ANSI.sub("", res.stderr or "")
+    return res
+
+
 def run_cli(args, ranks=None, timeout=300, cwd=None):
-    """Run ``mpipd ARGS`` (under ``mpirun -n ranks`` if given); returns CompletedProcess."""
+    """Run ``mpipd ARGS`` (under ``mpirun -n ranks`` if given); returns CompletedProcess
+    (stdout and stderr without terminal colour codes: :data:`ANSI`)."""
     cmd = [str(BIN / "mpipd"), *args]
     if ranks is not None:
         cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), *cmd]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd,
-                          env=child_env())
+    return _clean(subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
+                                 cwd=cwd, env=child_env()))
 
 
 def restart_matches(checkpoint, reference, keys, ranks, timeout=300) -> Path:
@@ -120,7 +135,8 @@ def restart_matches(checkpoint, reference, keys, ranks, timeout=300) -> Path:
 
 def run_mpi_script(script, ranks, *args, timeout=300):
     cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, str(script), *args]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=child_env())
+    return _clean(subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
+                                 env=child_env()))
 
 
 # ------------------------------------------------------------------ long stability cases
