@@ -21,7 +21,7 @@ from . import figures_curves as fc
 from . import figures_maps as fmap
 from .analysis import analyse
 from .model import load_model
-from .reader import Run
+from .reader import Run, shown_path
 from .report import _json, run_label
 from .sections import NAMED
 from .targets import TARGETS
@@ -90,7 +90,7 @@ def make_compare(paths, out, comm, labels=None, view="detonation-face") -> list[
             z = data["sections"]["levels"][section]
             pictures.append((label, model, data["sections"]["sections"].get(section),
                              ("damage", last), metrics["t_end_us"], z * 1e3))
-            runs.append({"label": label, "run_file": str(Path(path).resolve()),
+            runs.append({"label": label, "run_file": shown_path(path),
                          "n_points": n_points, **metrics})
     if comm.Get_rank() != 0:
         return []

@@ -21,6 +21,18 @@ from mpipd.parallel.team import Team
 REQUIRED = ("geometry/x", "geometry/volume", "geometry/part", "geometry/material", "time")
 
 
+def shown_path(path) -> str:
+    """A run file as reports and the record name it: relative to the working directory
+    when it lies under it (so that no machine path lands in a committed report), else
+    absolute."""
+    from pathlib import Path
+    p = Path(path).resolve()
+    try:
+        return str(p.relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(p)
+
+
 class RunFileError(Exception):
     """The file cannot be analysed (one line, names the file and the reason)."""
 

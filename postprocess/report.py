@@ -14,7 +14,7 @@ from . import figures_curves as fc
 from . import figures_maps as fmap
 from .analysis import analyse
 from .model import load_model
-from .reader import Run
+from .reader import Run, shown_path
 
 
 def run_label(path, model) -> str:
@@ -84,7 +84,7 @@ def make_report(path, out, comm, pattern_us=None) -> list[str]:
         model.label = label
         metrics, data = analyse(run, model, pattern_us)
         times = run.time
-        info = {"run_file": str(Path(path).resolve()), "label": label,
+        info = {"run_file": shown_path(path), "label": label,
                 "n_points": run.n_points, "run_ranks": _int(run.attr("ranks")),
                 "dt_s": _float(run.attr("dt")), "steps": _int(run.attr("steps")),
                 "git_commit": str(run.attr("git_commit", "unknown")),

@@ -39,6 +39,7 @@ from pathlib import Path
 from .analysis import target_bounds
 from .case_coverage import coverage_table
 from .crack_orientation import CLASSES, RING_FRACTION, rings_text
+from .reader import shown_path
 from .targets import BY_KEY, TARGETS, verdict
 
 MAX_WIDTH = 900
@@ -70,15 +71,6 @@ class Input:
 
 
 # ------------------------------------------------------------------ inputs
-
-def _shown_path(path: str) -> str:
-    """A run file as the record shows it: relative to the repository when inside it
-    (so that no machine path lands in a committed file), else as recorded."""
-    root = Path(__file__).resolve().parents[1]
-    try:
-        return str(Path(path).relative_to(root))
-    except ValueError:
-        return path
 
 def how_to_make(run_file: Path) -> str:
     """The command that writes ``run_file``: a built-in scene (or SCENE:CASE) named by
@@ -212,7 +204,7 @@ def provenance(runs) -> list[str]:
         ("the gas acts on (interacts_with)",
          lambda r: "not in report.json" if model(r, "gas_acts_on") is None
          else ", ".join(model(r, "gas_acts_on")) or "nothing"),
-        ("run file", lambda r: f"`{_shown_path(get(r, 'run_file'))}`"),
+        ("run file", lambda r: f"`{shown_path(get(r, 'run_file'))}`"),
         ("report.json", lambda r: f"`{r['input'].report_dir / 'report.json'}` → "
          f"`{r['md_dir']}/report.json`"),
         ("run id", lambda r: get(r, "run_id")),

@@ -88,6 +88,9 @@
 # blast_paper_eq35 (04370ba, the base scene at the paper's model: Eq. 35's pressure, the gas on the copper only,
 #   the spring-fallback fix; notes §48; the Summary's row): mpirun -n 2 mpipd run blast_paper --set output.every=200
 #   --set output.checkpoint_every=500 --out runs/blast_paper_eq35
+# blast_paper_eos (ee4cce2, the base with Eq. 25's cubic EOS: issue 60 item 5's second row; physics of 04370ba):
+#   mpirun -n 2 mpipd run blast_paper:eos_pressure --set output.every=200 --set output.checkpoint_every=500
+#   --out runs/blast_paper_eos
 VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 runs/blast_paper_dx1.2_mr4/run.h5 \
     runs/blast_paper_dx1.2_rockmass_mr4/run.h5 runs/blast_paper_dx1.2_contained/run.h5 \
     runs/blast_paper_contained/run.h5 runs/blast_paper_dx1.0/run.h5 runs/blast_paper_kappa/run.h5 runs/blast_paper_graded_contained/run.h5 \
@@ -99,7 +102,8 @@ VALIDATE_RUNS ?= runs/blast_paper_mr4/run.h5 runs/blast_paper_graded_mr4/run.h5 
     runs/blast_paper_rerun/run.h5 runs/blast_paper_dx0.7/run.h5 \
     runs/blast_paper_dx1.2_gas_contact/run.h5 runs/blast_paper_gas_contact/run.h5 runs/blast_paper_seamless/run.h5 \
     runs/blast_paper_case5_rerun/run.h5 runs/blast_paper_rerun2/run.h5 runs/blast_paper_case6_rerun/run.h5 \
-    runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5 runs/blast_paper_eq35/run.h5
+    runs/demo/run.h5 runs/blast_demo_dx0.8/run.h5 runs/blast_paper_eq35/run.h5 \
+    runs/blast_paper_eos/run.h5
 VALIDATE_OUT ?= studies/validation/record
 VALIDATE_NOTES ?= studies/validation/notes.md
 VALIDATE_RANKS ?= 2
@@ -238,7 +242,7 @@ effective-load: install
 # pressure, the gas on the copper only, the spring-fallback fix; issue 60) beside the
 # previous model's last base row (blast_paper_rerun2), from the rows' report.json
 PM_BASE ?= studies/validation/record/blast_paper_rerun2
-PM_ROWS ?= $(wildcard studies/validation/record/blast_paper_eq35)
+PM_ROWS ?= $(wildcard studies/validation/record/blast_paper_eq35 studies/validation/record/blast_paper_eos)
 PM_OUT ?= studies/model/paper_model_blast_paper.md
 .PHONY: paper-model
 paper-model: install
