@@ -61,7 +61,7 @@ def test_scene_of_your_own_checks(tmp_path):
 
 
 def test_links_exist():
-    for target in re.findall(r"\]\(([^)#\s]+)\)", README):
+    for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)\s]*)?\)", README):
         if "://" in target:
             continue
         assert (ROOT / target).exists(), f"README links a missing file: {target}"
