@@ -15,9 +15,16 @@ which array):
 
 Importing mpipd never initialises MPI; the CLI and tests pass a communicator in.
 It does point numba's kernel cache at a directory keyed by the sources
-(mpipd.kernels.cache).
+(mpipd.kernels.cache), and turns numba's colouring of error messages off: with it,
+numba's colorama writes a colour reset (ESC[0m, no newline) to a terminal stdout at
+exit, and under mpirun every rank's stdout is a pseudo-terminal, so the fragment landed
+inside other ranks' lines (a run log's line, a verification row's JSON).
 """
-from .kernels.cache import configure as _configure_kernel_cache
+import os
+
+os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")   # before numba
+
+from .kernels.cache import configure as _configure_kernel_cache  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -94,11 +94,11 @@ def one_error(res, *needles, code=2):
         assert n in line, line
     return line
 
-#: a terminal colour code: under mpirun a rank's stdout is a pseudo-terminal, and each
-#: rank of a run writes a colour reset (ESC[0m, no newline) to it near its end (not
-#: mpipd's code; the string is in llvmlite's LLVM library); mpirun may forward that
-#: fragment ahead of another rank's next line, which then no longer starts with
-#: "mpipd: " (test_restart's probe lines, seen under load)
+#: a terminal colour code: under mpirun a rank's stdout is a pseudo-terminal, and
+#: numba's colorama wrote a colour reset (ESC[0m, no newline) to it at exit, which
+#: mpirun forwarded ahead of another rank's next line (test_restart's probe lines,
+#: benchmarks/verify.py's rows).  mpipd/__init__.py turns that colouring off; the tests
+#: still take any colour code out, so that one from elsewhere cannot fail them
 ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
@@ -243,3 +243,13 @@ def closure_without(e, term) -> float:
     held = e.held - (getattr(e, term) if term in HELD else 0.0)
     diss = e.dissipated - (getattr(e, term) if term in DISSIPATED else 0.0)
     return abs(e.initial + e.external - held - diss) / e.scale
+
+
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory):
+    """elastic_wave (SMALL) stopped at step 20 of 60: a checkpoint and 2 of 4 frames; one
+    per test module that asks for it."""
+    out = tmp_path_factory.mktemp("stopped") / "s"
+    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
+    assert res.returncode == 0, res.stdout + res.stderr
+    return out

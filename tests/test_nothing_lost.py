@@ -119,14 +119,6 @@ def test_an_early_stop_keeps_frames_written_after_the_checkpoint(tmp_path):
 
 # ----------------------------------------------------------------- data loss 2, defect 5
 
-@pytest.fixture(scope="module")
-def stopped(tmp_path_factory):
-    out = tmp_path_factory.mktemp("stopped") / "s"
-    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
-    assert res.returncode == 0, res.stdout + res.stderr
-    return out
-
-
 @pytest.mark.parametrize("setting,key", [
     ('output.fields=["u"]', "output.fields"),
     ('output.fields=["u","v","stress"]', "output.fields"),

@@ -136,15 +136,6 @@ def test_a_never_lit_charge_has_infinite_lighting_times():
 
 # ----------------------------------------------------------------- checkpoints
 
-@pytest.fixture(scope="module")
-def stopped(tmp_path_factory):
-    """elastic_wave stopped at step 20 of 60 (a checkpoint, 2 of 4 frames)."""
-    out = tmp_path_factory.mktemp("ck") / "w"
-    res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--stop-after", "20"])
-    assert res.returncode == 0, res.stdout + res.stderr
-    return out
-
-
 def test_a_checkpoint_changed_after_it_was_written_is_refused(stopped, tmp_path):
     """Finite garbage (one velocity a millimetre per second off) passes the
     non-finite test; the checksum catches it: one line naming the dataset, exit 2,
