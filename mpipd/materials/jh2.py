@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numba
@@ -333,9 +334,9 @@ class JH2(Material):
         """True for ``pressure = "incremental"`` (Eq. 35), False for ``"eos"`` (Eq. 25)."""
         return self.pressure == "incremental"
 
-    @property
+    @cached_property
     def params(self) -> JH2Params:
-        """The kernel's constants (:class:`JH2Params`)."""
+        """The kernel's constants (:class:`JH2Params`), made once (the material is frozen)."""
         return JH2Params(float(self.shear_modulus), float(self.bulk_modulus), float(self.K2),
                          float(self.K3), float(self.sigma_hel), float(self.p_HEL),
                          float(self.A), float(self.N), float(self.B), float(self.M),
