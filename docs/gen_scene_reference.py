@@ -93,6 +93,7 @@ UNITS = {
     ("RadialVelocity", "r_inner"): "m", ("RadialVelocity", "r_outer"): "m",
     ("RadialVelocity", "speed"): "m/s",
     ("Absorbing", "at"): "m", ("Absorbing", "thickness"): "m", ("Absorbing", "reflection"): "1",
+    ("PrescribedVelocity", "ramp"): "s",
     ("BoreholePressure", "p0"): "Pa", ("BoreholePressure", "alpha"): "1/s",
     ("BoreholePressure", "beta"): "1/s", ("BoreholePressure", "times"): "s",
     ("BoreholePressure", "pressures"): "Pa",

@@ -449,6 +449,8 @@ def check_report(scene, ranks: int) -> str:
         kind = ("a set, spacing " + f"{jt.spacing:g} m" if jt.spacing > 0 else "one joint")
         out.append(f"  joint {i}: {kind} through {list(jt.point)}, normal {list(jt.normal)}, "
                    + (f"discs of radius {jt.radius:g} m" if jt.radius > 0 else "unbounded")
+                   + (f" within the box {list(jt.box.lo)}..{list(jt.box.hi)} m"
+                      if jt.box is not None else "")
                    + f", persistence {jt.persistence:g}"
                    + (f" in {jt.patch:g} m patches (seed {jt.seed})" if jt.persistence < 1 else "")
                    + f"; cuts {', '.join(jt.parts) if jt.parts else 'every solid part'}: "

@@ -529,7 +529,8 @@ def summary(run: RunIO, first: int, wall: float, checkpointer, end_error: str | 
         if over:
             log(f"mpipd: warning: {over}", error=True)
     e = sim.energies()
-    log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J = "
+    log(f"mpipd: energy ledger: initial {e.initial:.6g} J + external {e.external:.6g} J"
+        + (f" + boundary {e.boundary:.6g} J" if e.boundary else "") + " = "
         f"held {e.held:.6g} J + dissipated {e.dissipated:.6g} J; balance {e.balance:+.2e}")
     for msg in impossible(e):
         log(f"mpipd: warning: impossible energy: {msg}", error=True)

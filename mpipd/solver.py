@@ -14,12 +14,14 @@ One step (velocity Verlet, DESIGN §4), over the scene's models
 model family the scene's materials name, :data:`FAMILY_MODELS`)::
 
     kick_drift                      v += dt/2 a; u += dt v   (owned)
+    drive.drift                     driven points: v, u from the prescribed velocity
     halo: u, v                      owned -> ghosts
     model.update                    F, Fdot, R, V, d, sigma; the gas's pressure (owned)
     model.force_data                B, h; the gas's A, V, p (owned)
     halo: every model's force data  owned -> ghosts (one call)
     model.gather                    f_i from own + ghost data (owned)
     kick                            a = f / rho; v += dt/2 a
+    drive.hold                      driven points: v = the prescribed velocity
 
 No MPI call appears here except through the halo and the team.
 """
@@ -31,12 +33,13 @@ import numpy as np
 
 from .input.geometry import LayerTable
 from .input.joints import cut_joints
-from .input.loads import refuse_empty, regions
+from .input.loads import PrescribedVelocity, refuse_empty, regions
 from .input.probes import place
 from .kernels import integrate, runaway
 from .kernels.layout import N_MODES, SPRING_K
 from .model.base import Model
 from .model.correspondence import Correspondence
+from .model.drive import Drive
 from .model.failure import Failure
 from .model.families import build_families
 from .model.gas import Gas
@@ -111,6 +114,11 @@ class Simulation:
         for ic in scene.initial:
             ic.apply(p.x[:n], self.v[:n])
         self.v[:n][self.fixed.astype(bool)] = 0.0
+        # prescribed velocities (fixed for the integrator; the drive moves them)
+        driven = [bc for bc in scene.boundaries if isinstance(bc, PrescribedVelocity)]
+        self.drive = Drive(driven, p.x[:n], self.rho, p.volume[:n]) if driven else None
+        if self.drive is not None:
+            self.drive.register(st)
 
         sv = scene.solver
         # step classes (multi-rate; all 0 in a single-rate scene)
@@ -210,6 +218,8 @@ class Simulation:
         self.compute_forces()
         self.apply_loads(self.t, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
+        if self.drive is not None:
+            self.drive.start(self.f, self.u, self.v, self.t)
         self.ledger.start(self.interface)
         self.peaks.sample(self)
 
@@ -238,6 +248,8 @@ class Simulation:
         if self.loads:
             self.apply_loads(self.t + dt, 0.0)
         integrate.kick(self.v, self.f, self.rho, 0.0, self.fixed, self.a)
+        if self.drive is not None:
+            self.drive.start(self.f, self.u, self.v, self.t + dt)
         self.ledger.start(self.interface)
         jump = before - self.ledger.integrator(self)
         if reclassified:
@@ -262,6 +274,8 @@ class Simulation:
         rows = self.classes.reweighted_rows()
         self.corr.reweight(rows, self.u, self.v, self.f, self.ledger.fv, self.classes.previous)
         integrate.accelerations(self.f, self.rho, self.fixed, rows, self.a)
+        if self.drive is not None:
+            self.drive.start(self.f, self.u, self.v, self.t + self.dt)
         self.ledger.start(self.interface)
         self.ledger.reclass += before - self.ledger.integrator(self)
 
@@ -313,9 +327,15 @@ class Simulation:
         cl.set_level(self.step_count + 1)
         integrate.kick_drift(self.u, self.v, self.a, dt, self.fixed, self.damp,
                              self.ledger.edamp)
+        if self.drive is not None:
+            self.drive.drift(self.u, self.v, self.t, dt)
         self.update(dt)
         self.ledger.book_work(self.v, self.points.volume, dt, self.interface)
+        if self.drive is not None:
+            self.drive.book(self.f, self.v, self.points.volume, dt)
         integrate.kick(self.v, self.f, self.rho, dt, self.fixed, self.a)
+        if self.drive is not None:
+            self.drive.hold(self.u, self.v, self.t, dt)
         self.peaks.sample(self)
         refresh = False
         if self.failure is not None:                # paper §2.7 steps 11–12, every step

@@ -242,7 +242,7 @@ def closure_without(e, term) -> float:
     from mpipd.model.ledger import DISSIPATED, HELD
     held = e.held - (getattr(e, term) if term in HELD else 0.0)
     diss = e.dissipated - (getattr(e, term) if term in DISSIPATED else 0.0)
-    return abs(e.initial + e.external - held - diss) / e.scale
+    return abs(e.initial + e.external + e.boundary - held - diss) / e.scale
 
 
 @pytest.fixture(scope="module")

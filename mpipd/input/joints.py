@@ -3,7 +3,9 @@
 A joint is a plane through ``point`` with unit ``normal`` (any length; it is
 normalised); ``radius`` bounds it to a disc (a penny-shaped flaw), ``spacing``
 makes it a set of parallel joints at every multiple of the spacing along the
-normal (a joint family).  ``persistence`` (0, 1] is the open fraction of each
+normal (a joint family).  ``box`` (``{ lo, hi }``, m) bounds it to the part of its plane inside an
+axis-aligned box (a notch cut in from an edge: the plane x = 0.025 inside the
+box 0 <= y <= 0.05 is a 50 mm deep cut of zero width).  ``persistence`` (0, 1] is the open fraction of each
 joint's area, in square patches of side ``patch`` drawn open or closed from
 ``seed`` (rock bridges between them).  ``parts`` names the parts it cuts (a
 graded part's rings by its name); empty: every solid part.
@@ -25,6 +27,7 @@ import numpy as np
 
 from ..kernels.hashrng import STREAM_JOINT
 from ..kernels.joints import cut_bonds
+from .loads import Region
 from .probes import part_matches
 from .schema import fail, join, non_negative
 
@@ -39,6 +42,7 @@ class Joint:
     patch: float = 0.0                  # patch side (m); needed when persistence < 1
     seed: int = 1
     parts: tuple[str, ...] = ()
+    box: Region | None = None           # None: not bounded by a box
 
     def check(self, path):
         if not math.hypot(*self.normal) > 0.0:
@@ -76,10 +80,12 @@ class Joint:
         else:
             cuts = np.asarray(solid, bool)
         n, e1, e2 = self.frame()
+        lo, hi = ((np.asarray(self.box.lo, float), np.asarray(self.box.hi, float))
+                  if self.box is not None else (np.full(3, -np.inf), np.full(3, np.inf)))
         return int(cut_bonds(points.x, points.gid, cuts, families.offsets, families.nbr,
                              families.broken, np.asarray(self.point, float), n, e1, e2,
                              float(self.spacing), float(self.radius), float(self.persistence),
-                             float(self.patch), int(self.seed), STREAM_JOINT + k))
+                             float(self.patch), int(self.seed), STREAM_JOINT + k, lo, hi))
 
 
 def cut_joints(joints, parts, points, families, solid) -> int:

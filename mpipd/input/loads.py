@@ -184,6 +184,44 @@ class Fixed:
     selects = mask
 
 
+@BOUNDARIES.register("prescribed_velocity")
+@dataclass(frozen=True)
+class PrescribedVelocity:
+    """Points inside ``region`` move with the prescribed ``velocity`` (m/s, a vector),
+    whatever the forces on them: a struck edge, a moving grip.  With ``ramp`` > 0 (s)
+    the velocity rises linearly from 0 at t = 0 to ``velocity`` at t = ramp (a ramp
+    spreads the jump a sudden impact puts into the first steps over several); with
+    ``ramp`` = 0 the points move at ``velocity`` from t = 0.  Their displacement
+    advances with it every step (u += dt v(t + dt/2): exact for the linear ramp), and
+    no force accelerates them (mpipd.model.drive).  The work the driven points do on
+    the body (the power of the reaction force on them, integrated in time, plus their
+    own kinetic energy's change) is the ledger's ``boundary``."""
+    region: Region
+    velocity: tuple[float, float, float]
+    ramp: float = 0.0
+    region_key = "region"
+
+    def check(self, path):
+        below_light(self, path, "velocity")
+        non_negative(self, path, "ramp")
+
+    @property
+    def what(self) -> str:
+        return self.region.what
+
+    def mask(self, x: np.ndarray) -> np.ndarray:
+        """The driven points: no force moves them (the solver's ``fixed`` flag); the
+        drive (mpipd.model.drive) sets their velocity and displacement."""
+        return self.region.contains(x)
+
+    selects = mask
+
+    def value(self, t: float) -> np.ndarray:
+        """The prescribed velocity (m/s) at time t."""
+        s = 1.0 if self.ramp <= 0.0 else min(max(t / self.ramp, 0.0), 1.0)
+        return s * np.asarray(self.velocity, dtype=float)
+
+
 #: a face of an axis-aligned boundary: (axis, outward sign)
 FACES = {"-x": (0, -1.0), "+x": (0, 1.0), "-y": (1, -1.0), "+y": (1, 1.0),
          "-z": (2, -1.0), "+z": (2, 1.0)}

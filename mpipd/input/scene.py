@@ -13,11 +13,12 @@ A scene has these tables (see ``mpipd/scenes/elastic_wave.toml``)::
     [solver]      hourglass (Eq. 15 coefficient, default 0.01), progress_every,
                   max_imbalance (the ledger bound that stops a run, default 1e-2), ...
     [[initial]]   kind = "velocity_pulse" | "uniform_velocity" | "gaussian_velocity", ...
-    [[boundaries]] kind = "fixed", region = { lo, hi }
+    [[boundaries]] kind = "fixed", region = { lo, hi } | "prescribed_velocity", region,
+                  velocity, ramp | "absorbing", face, at, thickness, reflection
     [[loads]]     kind = "borehole_pressure", center, radius, p0/alpha/beta or times/pressures
     [[probes]]    name, position, center (radial axis), part (snap to that part's
                   points only): recorded every step
-    [[joints]]    point, normal, radius, spacing, persistence, patch, seed, parts:
+    [[joints]]    point, normal, radius, spacing, persistence, patch, seed, parts, box:
                   pre-existing joints whose crossing bonds start broken (mpipd.input.joints)
     [output]      every (steps), fields
 

@@ -106,3 +106,14 @@ def kinetic_energy(v, rho, vol):
     for i in range(rho.shape[0]):
         e += 0.5 * rho[i] * vol[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
     return e
+
+
+@numba.njit(cache=True)
+def drive(u, v, idx, vel, dt):
+    """v_i = vel[k] and u_i += dt vel[k] for i = idx[k]: the prescribed motion of
+    driven points (mpipd.model.drive; dt = 0 sets the velocity only)."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        for c in range(3):
+            v[i, c] = vel[k, c]
+            u[i, c] += dt * vel[k, c]

@@ -7,6 +7,9 @@ x_a -> x_b has n . (x - p) - c_k of opposite signs at its ends (a point on a
 plane counts as above it: the sign test is on floor(n . (x - p) / s)); the
 crossing point is x_a + t (x_b - x_a), t = (c_k - s_a) / (s_b - s_a).
 
+A crossing point outside the box ``box_lo``..``box_hi`` (bounds inclusive;
+infinite: no box) does not count: the joint is bounded to the box.
+
 A plane is open at the crossing point when its patch — the square of side
 ``patch`` of the in-plane coordinates (e1, e2) that holds the point — is drawn
 open, u(seed, k, i1, i2) < persistence (mpipd.kernels.hashrng), so a fraction
@@ -39,11 +42,12 @@ def _patch_open(seed, stream, k, i1, i2, persistence):
 
 @numba.njit(cache=True)
 def cut_bonds(x, gid, cuts, offsets, nbr, broken, p, n, e1, e2, spacing, radius,
-              persistence, patch, seed, stream):
+              persistence, patch, seed, stream, box_lo, box_hi):
     """Set broken[b] = 1 for every bond b = (i, nbr[b]) of an owned point i whose two
     ends are both in ``cuts`` (a bool per local point) and that crosses an open
-    part of the joint set.  ``spacing`` <= 0: one plane; ``radius`` <= 0: unbounded;
-    ``persistence`` >= 1: open everywhere.  Returns the number of bonds newly cut."""
+    part of the joint set inside the box ``box_lo``..``box_hi``.  ``spacing`` <= 0:
+    one plane; ``radius`` <= 0: unbounded; ``persistence`` >= 1: open everywhere.
+    Returns the number of bonds newly cut."""
     count = 0
     for i in range(offsets.shape[0] - 1):
         if not cuts[i]:
@@ -71,6 +75,11 @@ def cut_bonds(x, gid, cuts, offsets, nbr, broken, p, n, e1, e2, spacing, radius,
                 q1 = x[a, 1] + t * (x[c, 1] - x[a, 1]) - p[1] - ck * n[1]
                 q2 = x[a, 2] + t * (x[c, 2] - x[a, 2]) - p[2] - ck * n[2]
                 inside = radius <= 0.0 or q0 * q0 + q1 * q1 + q2 * q2 <= radius * radius
+                c0 = q0 + p[0] + ck * n[0]
+                c1 = q1 + p[1] + ck * n[1]
+                c2 = q2 + p[2] + ck * n[2]
+                inside = (inside and box_lo[0] <= c0 <= box_hi[0]
+                          and box_lo[1] <= c1 <= box_hi[1] and box_lo[2] <= c2 <= box_hi[2])
                 if inside:
                     if persistence >= 1.0:
                         cut = True

@@ -16,6 +16,10 @@ Terms (J, global sums over the owned points of every rank)::
                 gas          sum V0 e: the explosive's internal energy (unreacted included)
                 gas_contact  the gas-solid contact's potential (mpipd.materials.jwl.GasContact;
                              0 without one)
+                gas_wall     the work done against the gas wall (mpipd.materials.jwl.GasWall:
+                             minus the trapezoidal work of its forces); its stored
+                             energy, of either sign as its force is not a potential
+                             one; 0 without one
     dissipated  plastic      sum over intact points V (W - e_el): plastic flow, damage
                              and the bulking pressure's work (W = the stress work)
                 removed      sum over failed or detached (K singular) points V W, plus
@@ -45,14 +49,18 @@ Terms (J, global sums over the owned points of every rank)::
                              ``removed`` elsewhere); 0 in a single-rate run
     in          initial      held at step 0
                 external     work of the loads (trapezoid)
-    balance     (initial + external - held - dissipated) / scale,
-                scale = max(|initial|, |external|, |held|, |dissipated|)
+                boundary     work of the prescribed-velocity boundaries
+                             (mpipd.model.drive: the power of the reaction force
+                             on the driven points by the trapezoid, plus their
+                             kinetic energy's change)
+    balance     (initial + external + boundary - held - dissipated) / scale,
+                scale = max(|initial|, |external|, |boundary|, |held|, |dissipated|)
 
 Every force the step applies is in exactly one of these: the correspondence
 force (its work is the stress work W, to O(dt^2)), hourglass, spring,
 contact and gas contact (potentials), gas (its work leaves e by the trapezoidal energy
 equation), viscosity, gas viscosity, damping, interface (their work), loads
-(external).
+(external); the driven points' share of them is the boundary's (boundary).
 So |balance| is the time-discretisation error, of order (omega dt)^2, plus
 one-step errors where forces switch (a failure, a break): a term left out
 shows as a balance of its own size.
@@ -73,11 +81,11 @@ from ..kernels.layout import INTACT, SPRING_K
 from ..state import AUX, LAST
 
 HELD = ("kinetic", "integrator", "elastic", "hourglass", "spring", "contact", "gas",
-        "gas_contact")
+        "gas_contact", "gas_wall")
 DISSIPATED = ("plastic", "removed", "contact_onset", "viscous", "damping", "gas_damping",
               "gas_viscous", "absorbed", "interface", "multirate")
 #: the datasets of /energy in a run file, in this order
-TERMS = ("t",) + HELD + DISSIPATED + ("external", "initial", "balance")
+TERMS = ("t",) + HELD + DISSIPATED + ("external", "boundary", "initial", "balance")
 #: terms that cannot be negative (beyond round-off and O(dt^2) noise)
 NON_NEGATIVE = ("kinetic", "elastic", "hourglass", "spring", "contact", "gas", "gas_contact",
                 "plastic",
@@ -97,6 +105,7 @@ class Energies:
     contact: float = 0.0
     gas: float = 0.0
     gas_contact: float = 0.0
+    gas_wall: float = 0.0
     plastic: float = 0.0
     removed: float = 0.0
     contact_onset: float = 0.0
@@ -108,6 +117,7 @@ class Energies:
     interface: float = 0.0
     multirate: float = 0.0
     external: float = 0.0
+    boundary: float = 0.0
     initial: float = 0.0
 
     @property
@@ -126,18 +136,20 @@ class Energies:
 
     @property
     def scale(self) -> float:
-        return max(abs(self.initial), abs(self.external), abs(self.held),
-                   abs(self.dissipated), 1e-300)
+        return max(abs(self.initial), abs(self.external), abs(self.boundary),
+                   abs(self.held), abs(self.dissipated), 1e-300)
 
     @property
     def balance(self) -> float:
-        """Relative closure error (initial + external - held - dissipated) / scale."""
-        return (self.initial + self.external - self.held - self.dissipated) / self.scale
+        """Relative closure error (initial + external + boundary - held - dissipated)
+        / scale."""
+        return (self.initial + self.external + self.boundary - self.held
+                - self.dissipated) / self.scale
 
     @classmethod
     def from_record(cls, group, frame: int = -1) -> "Energies":
         """The reading of one frame of a run file's ``/energy`` group (h5py); a term
-        the file predates (``multirate``, ``absorbed``, ``gas_viscous``, ``gas_contact``)
+        the file predates (``multirate``, ``absorbed``, ``gas_viscous``, ``gas_contact``, ``boundary``)
         reads 0."""
         return cls(**{f.name: float(group[f.name][frame]) if f.name in group else 0.0
                       for f in fields(cls)})
@@ -245,6 +257,7 @@ class Ledger:
         gas = sim.gas.energy() if sim.gas is not None else 0.0
         gas_viscous = sim.gas.viscous_work if sim.gas is not None else 0.0
         gas_contact = sim.gas.contact_energy() if sim.gas is not None else 0.0
+        gas_wall = sim.gas.wall_energy() if sim.gas is not None else 0.0
         damping = gas_damping = absorbed = 0.0
         if len(self.edamp):
             ed = m * self.edamp
@@ -253,10 +266,11 @@ class Ledger:
             absorbed = float(ed[self.layer].sum())
             damping = float(ed.sum()) - gas_damping - absorbed
         return np.array([ke, integ, elastic, pot[0], pot[1], pot[2], gas, gas_contact,
-                         plastic, removed,
+                         gas_wall, plastic, removed,
                          self.contact_jumps, -self.viscous_work, damping, gas_damping,
                          gas_viscous, absorbed,
-                         -self.interface_work, self.reclass, sim.external_work])
+                         -self.interface_work, self.reclass, sim.external_work,
+                         sim.drive.work if getattr(sim, "drive", None) is not None else 0.0])
 
     def read(self, sim) -> Energies:
         tot = sim.team.sum(self.local(sim))

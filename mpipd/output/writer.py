@@ -207,7 +207,7 @@ class Writer:
         eg = self.f.create_group("energy")
         eg.attrs["doc"] = (f"energy ledger (J), see mpipd.model.ledger: held = {' + '.join(HELD)}; "
                            f"dissipated = {' + '.join(DISSIPATED)}; balance = "
-                           "(initial + external - held - dissipated) / scale")
+                           "(initial + external + boundary - held - dissipated) / scale")
         self.energy = {k: eg.create_dataset(k, (self.n_frames,), "f8",
                                             **growable((self.n_frames,))) for k in TERMS}
         self.bonds, self.bond_rows = None, 0
