@@ -36,13 +36,14 @@ CASE = HERE / "verify_case.py"
 #: problems in table order; "serial": a material point, run on 1 rank only
 PROBLEMS = [("wave", False), ("lame", False), ("energy", False), ("jh2_point", True),
             ("detonation", False), ("isentrope_dt", False), ("wave_multirate", False),
-            ("borehole_multirate", False)]
+            ("borehole_multirate", False), ("kalthoff_winkler", False)]
 
 #: problems --quick runs on 1 rank only (the detonation run already covers the gas on 2)
 QUICK_SERIAL_ONLY = {"isentrope_dt"}
 
-#: problems --quick leaves out (tests/test_multirate.py runs the class boundary in make test)
-QUICK_SKIP = {"wave_multirate", "borehole_multirate"}
+#: problems --quick leaves out (tests/test_multirate.py runs the class boundary in make test,
+#: tests/test_kalthoff_winkler.py a coarse Kalthoff-Winkler on 1, 2 and 3 ranks)
+QUICK_SKIP = {"wave_multirate", "borehole_multirate", "kalthoff_winkler"}
 
 
 def child_env() -> dict:

@@ -17,6 +17,7 @@ key             module                problem
 ``isentrope_dt`` :mod:`.detonation`   the same at one dx with dt refined alone
 ``wave_multirate`` :mod:`.wave_multirate` the plane wave across a multi-rate class boundary
 ``borehole_multirate`` :mod:`.borehole_multirate` a borehole pressure pulse across one
+``kalthoff_winkler`` :mod:`.kalthoff_winkler` the crack angle at two notch tips (steel)
 ==============  ====================  ==============================================
 
 :mod:`.common` holds what they share (the paper's granite, scene building, the
@@ -30,10 +31,12 @@ from .borehole_multirate import BoreholeMultirate
 from .detonation import Detonation, IsentropeDt
 from .energy import Energy
 from .jh2_point import JH2Point
+from .kalthoff_winkler import KalthoffWinkler
 from .lame import Lame
 from .wave import Wave
 from .wave_multirate import WaveMultirate
 
 PROBLEMS = {"wave": Wave, "lame": Lame, "energy": Energy, "jh2_point": JH2Point,
             "detonation": Detonation, "isentrope_dt": IsentropeDt,
-            "wave_multirate": WaveMultirate, "borehole_multirate": BoreholeMultirate}
+            "wave_multirate": WaveMultirate, "borehole_multirate": BoreholeMultirate,
+            "kalthoff_winkler": KalthoffWinkler}
