@@ -84,6 +84,8 @@ UNITS = {
     ("Unreacted", "c0"): "m/s", ("Unreacted", "s"): "1", ("Unreacted", "solid_density"): "kg/m³",
     ("BulkViscosity", "quadratic"): "1", ("BulkViscosity", "linear"): "1",
     ("GasContact", "distance"): "× lattice spacing", ("GasContact", "stiffness"): "× ρ₀ vod²",
+    ("GasWall", "material"): "—", ("GasWall", "distance"): "× gas lattice spacing",
+    ("GasWall", "stiffness"): "× ρ₀ vod²",
     ("TensionFailure", "sigma_st"): "Pa", ("TensionFailure", "c1"): "1",
     ("TensionFailure", "rate0"): "1/s",
     ("Weibull", "modulus"): "1", ("Uniform", "width"): "1", ("Normal", "cv"): "1",

@@ -38,7 +38,7 @@ from . import MATERIALS
 
 #: the peak gas pressure the paper reports (Pa; Fig. 7, "up to 1800 MPa"): below Table 2's
 #: own p(1, e0) and p_CJ (above), so a consistency row of the validation report
-#: (postprocess.targets), quoted by the run log beside the run's CJ state (mpipd.cli)
+#: (mpipd.post.targets), quoted by the run log beside the run's CJ state (mpipd.cli)
 PAPER_PEAK_PRESSURE = 1.8e9
 
 
@@ -95,6 +95,48 @@ class GasContact:
         positive(self, path, "distance", "stiffness")
         if self.distance > 1.0:
             fail(join(path, "distance"), "must be at most 1 (a fraction of the pair's "
+                                         "lattice spacing)")
+
+
+@dataclass(frozen=True)
+class GasWall:
+    """The wall that holds the gas: a contact of the gas with the *surface* of one
+    solid it acts on (the copper tube's inner face), not with its points (not in the
+    paper, whose tube is there "to prevent the explosive gas penetrating into the
+    blasting-induced fractures", §2.6, but whose Eqs. 45-48 have no force by which the
+    tube pushes the gas back).
+
+    :class:`GasContact` repels gas-solid *pairs*; once the tube stretches, the gaps
+    between its points open wider than two contact reaches and the gas passes
+    between them (studies/validation/notes.md §48).  Here a gas point sees one
+    surface interpolated over the wall's points within its horizon (Shepard
+    weights w_j = (1 - |Y_j| / delta)^2, current positions): its foot c = sum w y_j /
+    sum w, its normal n the direction of least spread of those points (the
+    weighted covariance's smallest eigenvector, oriented as their reference normals;
+    the reference normals themselves where the points do not span a plane), the face
+    half a wall spacing h = sum w l_j / (2 sum w) off the points, and the gap
+    g = (y_i - c) . n - h.  A gas point nearer than
+
+        g_0 = min(distance l_i, g at the first step)     (l_i its lattice spacing)
+
+    is pushed back along n with F = stiffness K l_i (g_0 - g) (K = rho0 vod^2, the
+    charge's bulk modulus, as :class:`GasContact`), and -F is shared over the wall
+    points in proportion to w_j (momentum is conserved).  The force is not the
+    gradient of a potential (n and c move with the wall): its work, by the
+    trapezoid over every step, is booked in the ledger's held ``gas_contact``.
+
+    ``material``: the solid whose surface is the wall (one of ``interacts_with``);
+    its wall points are those whose own family's first moment points away from the
+    gas (the layer that faces it).  ``distance = 0.5`` (the gas cell's half width
+    against the face) and ``stiffness = 2.0``."""
+    material: str
+    distance: float = 0.5
+    stiffness: float = 2.0
+
+    def check(self, path):
+        positive(self, path, "distance", "stiffness")
+        if self.distance > 1.0:
+            fail(join(path, "distance"), "must be at most 1 (a fraction of the gas's "
                                          "lattice spacing)")
 
 
@@ -190,6 +232,9 @@ class Explosive(JWL):
 
     ``contact = { distance, stiffness }``: the gas's non-penetration of the solids it
     acts on (:class:`GasContact`); off by default (the paper's model has none).
+
+    ``wall = { material, distance, stiffness }``: the gas held by the surface of one
+    solid it acts on (:class:`GasWall`); off by default.
     """
     initiation_z: float = 0.0
     direction: float = 1.0
@@ -200,6 +245,7 @@ class Explosive(JWL):
     unreacted: Unreacted | None = None
     viscosity: BulkViscosity | None = None
     contact: GasContact | None = None
+    wall: GasWall | None = None
     tension: None = None
     family = "ul"                       # its points are the updated-Lagrangian gas
 
@@ -219,6 +265,12 @@ class Explosive(JWL):
             self.viscosity.check(join(path, "viscosity"))
         if self.contact is not None:
             self.contact.check(join(path, "contact"))
+        if self.wall is not None:
+            self.wall.check(join(path, "wall"))
+            if self.wall.material not in self.interacts_with:
+                fail(join(join(path, "wall"), "material"),
+                     f"{self.wall.material!r} is not among interacts_with "
+                     f"{list(self.interacts_with)}: the gas holds only the solids it acts on")
 
     @property
     def bulk_viscosity(self) -> tuple[float, float]:
@@ -232,6 +284,13 @@ class Explosive(JWL):
         (0, 0) without one."""
         c = self.contact
         return (0.0, 0.0) if c is None else (c.distance, c.stiffness * self.bulk_modulus)
+
+    @property
+    def wall_law(self) -> tuple[float, float]:
+        """(distance, stiffness x K) of :class:`GasWall` (K = rho0 vod^2, Pa); (0, 0)
+        without one."""
+        w = self.wall
+        return (0.0, 0.0) if w is None else (w.distance, w.stiffness * self.bulk_modulus)
 
     @property
     def unreacted_eos(self) -> tuple[float, float, float]:

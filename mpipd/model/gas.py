@@ -38,7 +38,10 @@ material.
   ``gas``.  With a bulk viscosity (the material's ``viscosity``), the work of its
   q is summed in ``viscous_work`` (this rank's share): the ledger's ``gas_viscous``.
   With a contact (the material's ``contact``), gas-solid pairs repel when close:
-  its potential is the ledger's ``gas_contact``.
+  its potential is the ledger's ``gas_contact``.  With a wall (the material's
+  ``wall``, mpipd.materials.jwl.GasWall; kernels mpipd.kernels.wall), the gas is
+  held by the interpolated surface of one solid; the work done against it (the
+  trapezoid over every step, this rank's owned points) is the ledger's ``gas_wall``.
 """
 from __future__ import annotations
 
@@ -49,7 +52,9 @@ from scipy.spatial import cKDTree
 
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows, near_cells
+from ..kernels.energy import trapezoid_work
 from ..kernels.ul import GasParams, gas_contact_energy, gas_gather, gas_update
+from ..kernels.wall import wall_gather, wall_update
 from ..parallel.near import NearHalo
 from ..state import AUX, LOCAL
 from .base import Model
@@ -197,6 +202,9 @@ class Gas(Model):
         self.near = None                         # the remote solids (several ranks)
         if slabs is not None and team.size > 1 and len(acts):
             self.near = _near_halo(team.comm, slabs, p, self.solids_owned, gas_all)
+        self.wall_frac, self.wall_k = m.wall_law
+        if self.wall_frac > 0.0:
+            self._wall_table(names.index(m.wall.material))
         self._extend(0)
         self._y = np.zeros((nl, 3))              # x + u of the local points, this step
         self.y = None                            # current positions (y_ext) of the last update
@@ -223,6 +231,73 @@ class Gas(Model):
         self.h_ext = np.concatenate((self.gas_horizon, np.zeros(n_remote)))
         self.el_ext = np.concatenate((self.eligible,
                                       np.arange(nl, nl + n_remote, dtype=self.eligible.dtype)))
+        if self.wall_frac > 0.0:
+            k = np.searchsorted(self.wall_gid, self.gid_ext)
+            k = np.minimum(k, len(self.wall_gid) - 1)
+            hit = self.wall_gid[k] == self.gid_ext
+            self.wall_ext = hit.astype(np.uint8)
+            self.wallN_ext = np.where(hit[:, None], self.wall_N[k], 0.0)
+            self.walll_ext = np.where(hit, self.wall_l[k], 0.0)
+
+    def _wall_table(self, wid: int):
+        """The wall points of material ``wid`` (collective): its owned points with gas
+        within the gas reach whose own family's first moment, sum (1 - r/delta)^2 V
+        (x_k - x_j) over the same material, points away from the gas, and with no
+        point of that material in front of them (more than half a spacing nearer
+        the gas along N, within a spacing of N's line): the layer facing the gas.
+        Their reference normal N = minus that moment, normalised, and lattice
+        spacing V^(1/3).  Every rank gets the table of all of them, by gid
+        (a remote row is looked up in it).  Reference positions; the static halo
+        holds every neighbour of an owned point."""
+        p = self.points
+        n = p.n_owned
+        same = np.flatnonzero(p.material == wid)
+        cand = same[same < n]
+        gas = self.gas_all
+        keep = np.zeros(len(cand), bool)
+        N = np.zeros((len(cand), 3))
+        if len(cand) and len(gas):
+            tree_s, tree_g = cKDTree(p.x[same]), cKDTree(p.x[gas])
+            gid = p.gid
+            for a, j in enumerate(cand):        # sums in gid order: any rank count
+                nb = same[tree_s.query_ball_point(p.x[j], p.horizon[j])]
+                nb = nb[np.argsort(gid[nb], kind="stable")]
+                d = p.x[nb] - p.x[j]
+                w = (1.0 - np.linalg.norm(d, axis=1) / p.horizon[j]) ** 2 * p.volume[nb]
+                mom = (w[:, None] * d).sum(axis=0)
+                ng = gas[tree_g.query_ball_point(p.x[j], self.reach)]
+                ng = ng[np.argsort(gid[ng], kind="stable")]
+                if not len(ng) or not np.any(mom):
+                    continue
+                dg = p.x[ng] - p.x[j]
+                wg = (1.0 - np.linalg.norm(dg, axis=1) / self.reach) ** 2 * p.volume[ng]
+                towards = (wg[:, None] * dg).sum(axis=0)
+                N[a] = -mom / np.linalg.norm(mom)
+                # facing the gas, with no point of its own in front of it (half a
+                # spacing nearer the gas, within a spacing of its normal's line)
+                lj = p.volume[j] ** (1.0 / 3.0)
+                along = d @ N[a]
+                side = np.linalg.norm(d - along[:, None] * N[a], axis=1)
+                keep[a] = (float(N[a] @ towards) > 0.0
+                           and not np.any((along > 0.5 * lj) & (side < lj)))
+        got = self.team.gather((p.gid[cand[keep]], N[keep], p.volume[cand[keep]] ** (1.0 / 3.0)))
+        gid = np.concatenate([g[0] for g in got]).astype(np.int64)
+        order = np.argsort(gid)
+        self.wall_gid = gid[order]
+        self.wall_N = np.concatenate([g[1] for g in got]).reshape(-1, 3)[order]
+        self.wall_l = np.concatenate([g[2] for g in got])[order]
+        nl = p.n_local
+        self.ell = self.V0 ** (1.0 / 3.0)
+        self.g0 = np.full(len(self.gas_idx), np.nan)  # standoffs, set at first contact check
+        self.gw = np.zeros((nl, 3))                   # F_i / S_i of the gas (exchanged)
+        self.gF = np.zeros((nl, 3))                   # F_i of the owned gas
+        self.fw = np.zeros((len(self.rows), 3))       # the wall's force densities, rows order
+        self.fw_old = np.zeros_like(self.fw)
+        self.wall_work = 0.0                          # work of the wall forces, this rank (J)
+        self.wall_on = 0                              # owned gas points pushed, last step
+        self.wall_depth = 0.0                         # their largest (g_0 - g) / l, last step
+        self._booked = False                          # update() since the last gather
+        self._dt = 0.0
 
     def register(self, state):
         """The gas's arrays in the State (owner "gas") under the checkpoint names of
@@ -254,6 +329,14 @@ class Gas(Model):
         for name in ("y_ext", "v_ext", "vol_ext", "gid_ext", "isgas_ext", "h_ext", "el_ext"):
             add(f"gas_{name}", own, get=lambda name=name: getattr(self, name), rows=AUX)
         add("gas_q", own, self.gq, rows=self.gas_idx, checkpoint=self.viscous)
+        if self.wall_frac > 0.0:
+            add("gas_wall_g0", own, self.g0, rows=self.gas_idx, checkpoint=True)
+            add("gas_wall_gw", own, self.gw, rows=LOCAL, exchanged=True, checkpoint=True)
+            add("gas_wall_F", own, self.gF, rows=LOCAL, checkpoint=True)
+            add("gas_wall_fw", own, self.fw, rows=AUX)
+            add("gas_wall_fw_old", own, self.fw_old, rows=AUX)
+            state.scalar("gas_wall_work", own, lambda: self.wall_work,
+                         lambda v: setattr(self, "wall_work", float(v)))
         if self.viscous:
             state.scalar("gas_viscous_work", own, lambda: self.viscous_work,
                          lambda v: setattr(self, "viscous_work", float(v)))
@@ -361,12 +444,19 @@ class Gas(Model):
         self.tuner.step(time.perf_counter() - t0)
         self.viscous_work += wq
         self.V_ratio[self.gas_idx] = self.V_w[self.gas_idx] / self.V0
+        if self.wall_frac > 0.0:
+            self.wall_on, self.wall_depth = wall_update(
+                self.gas_idx, y, self.offsets, self.nbr, self.wall_ext, self.wallN_ext,
+                self.walll_ext, p.horizon, self.ell, self.g0, self.gw, self.gF,
+                self.wall_frac, self.wall_k)
+            self._booked, self._dt = True, dt
         if len(self.gas_idx):
             self.peak_pressure = max(self.peak_pressure, float(self.gd[self.gas_idx, GD_P].max()))
 
     def force_data(self, u, ledger=None) -> tuple:
-        """The owned gas's force data, made by :meth:`update` (gd: A, V, p)."""
-        return (self.gd,)
+        """The owned gas's force data, made by :meth:`update` (gd: A, V, p; with a
+        wall, its F / S too)."""
+        return (self.gd, self.gw) if self.wall_frac > 0.0 else (self.gd,)
 
     def gather(self, u, v, f, fv=None):
         """UL forces into f; u must be the displacement update() last saw, or the
@@ -379,6 +469,18 @@ class Gas(Model):
         gas_gather(self.rows, self.y, self.vol_ext, self.V_w, self.V_ratio, self.gd,
                    p.horizon, self.offsets, self.nbr, self.isgas_ext, f, self.x_ext,
                    self.contact_frac, self.contact_k)
+        if self.wall_frac > 0.0:
+            wall_gather(self.rows, self.y, self.offsets, self.nbr, self.isgas_ext,
+                        self.wall_ext, p.horizon, self.gw, self.gF, self.vol_ext, f, self.fw)
+            # the work over the step just taken (v = v_{n+1/2} after an update); a
+            # gather without one (step 0, a restore, a refresh after breakage: the
+            # same positions) only makes these forces the last ones
+            if self._booked:
+                self.wall_work += trapezoid_work(self.fw_old, self.fw, self.rows, v,
+                                                 p.volume, self._dt)
+                self._booked = False
+            else:
+                self.fw_old[...] = self.fw
         self.tuner.spent(time.perf_counter() - t0)
 
     def lit_density(self, team) -> dict:
@@ -413,6 +515,11 @@ class Gas(Model):
             return 0.0
         return gas_contact_energy(self.gas_idx, self.y, self.x_ext, self.vol_ext, self.offsets,
                                   self.nbr, self.isgas_ext, self.contact_frac, self.contact_k)
+
+    def wall_energy(self) -> float:
+        """The work done against the gas wall (J, this rank's owned points): minus the
+        trapezoidal work of its forces since step 0; 0 without a wall."""
+        return -self.wall_work if self.wall_frac > 0.0 else 0.0
 
     def carries_force(self) -> np.ndarray:
         """1 at the owned gas points whose force state is not zero after the last update
