@@ -44,8 +44,8 @@ lammps:
 
 demo: install
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/demo --overwrite
-	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
-	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/demo/run.h5 --out runs/demo/report
+	$(MPIRUN) -n 2 $(PY) -m mpipd.post fracture runs/demo/run.h5 --z 0.0005 --out runs/demo/fracture.png
+	$(MPIRUN) -n 2 $(PY) -m mpipd.post report runs/demo/run.h5 --out runs/demo/report
 	@echo "demo: the fracture pattern is in $(CURDIR)/runs/demo/fracture.png (validation report: runs/demo/report/report.md, fields: runs/demo/run.h5, ParaView: runs/demo/run.xdmf)"
 
 # the README's picture: make demo first; the caption names the run file's commit

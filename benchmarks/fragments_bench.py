@@ -6,7 +6,7 @@
 For each size: an elastic granite cube of about that many points at dx = 1 mm, cut
 by three sets of joints 7 mm apart (x, y and z planes: blocks of 7^3 points), is
 written at step 0 (``mpipd run``, steps = 0: the broken bonds are the joints', a
-synthetic fracture field with a known answer), then ``python -m postprocess
+synthetic fracture field with a known answer), then ``python -m mpipd.post
 fragments`` runs on each rank count.  Printed: the command's wall time (start-up,
 rebuilding the families from the scene, labelling, statistics, files) and the
 fragment count, which must be the same on every rank count.
@@ -80,7 +80,7 @@ def main(argv=None):
         for ranks in map(int, args.ranks.split(",")):
             t0 = time.perf_counter()
             subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m",
-                            "postprocess", "fragments", str(d / "run" / "run.h5"), "--out",
+                            "mpipd.post", "fragments", str(d / "run" / "run.h5"), "--out",
                             str(d / f"frag{ranks}")], env=env, check=True,
                            stdout=subprocess.DEVNULL)
             wall = time.perf_counter() - t0

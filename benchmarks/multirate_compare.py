@@ -3,7 +3,7 @@
     python benchmarks/multirate_compare.py --out FILE.md LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 
 Each RUN_DIR holds ``run.h5`` and, for the target rows, ``report/report.json``
-(``python -m postprocess report``; without it the table has the run rows only), or
+(``python -m mpipd.post report``; without it the table has the run rows only), or
 only a ``report.json`` (a run whose file is elsewhere: ``studies/validation/record/<case>/``).
 The first run is the reference.  The table gives, for every run:
 
@@ -37,7 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from mpipd.output.writer import short_commit  # noqa: E402
-from postprocess.validation import evaluated_share  # noqa: E402
+from mpipd.post.validation import evaluated_share  # noqa: E402
 
 
 def read(run_dir: Path) -> dict:
@@ -60,13 +60,13 @@ def read(run_dir: Path) -> dict:
 
 
 def evaluated(segments) -> float | None:
-    """postprocess.validation.evaluated_share, rounded for the table."""
+    """mpipd.post.validation.evaluated_share, rounded for the table."""
     share = evaluated_share(segments)
     return None if share is None else round(share, 4)
 
 
 def lattice_rows(report: dict) -> list[tuple[str, str, object]]:
-    """The lattice-bias measure (postprocess.lattice_bias) as target-like rows: a4, a8
+    """The lattice-bias measure (mpipd.post.lattice_bias) as target-like rows: a4, a8
     and the major radial cracks, each the mean over the report's sections."""
     lb = report.get("lattice_bias")
     if not isinstance(lb, dict):
@@ -225,7 +225,7 @@ def main(argv=None):
             + "Made by `python benchmarks/multirate_compare.py` from the run directories "
             + ", ".join(f"`{item.partition('=')[2]}`" for item in args.runs)
             + f"; the reference is {list(runs)[0]}.  {sources(runs)}, then the report's "
-            "targets (postprocess report) where the runs have one; in brackets the "
+            "targets (mpipd.post report) where the runs have one; in brackets the "
             "difference from the reference.\n\n"
             + table(runs))
     if args.bands:

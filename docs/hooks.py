@@ -7,9 +7,9 @@ An unknown marker, or a generator that fails, fails the build.
 
 * ``scene-reference``: every scene key (docs/gen_scene_reference.py);
 * ``validation-summary``: the Summary section of studies/validation/record.md
-  (written by ``python -m postprocess validate``);
+  (written by ``python -m mpipd.post validate``);
 * ``validation-targets``: the judged quantities and their ranges
-  (``postprocess.targets.TARGETS``);
+  (``mpipd.post.targets.TARGETS``);
 * ``bench-table``: the throughput table of the newest committed ``make bench`` log,
   studies/bench_logs/make_bench_<commit>.log (``benchmarks/bench_table.py``).
 """
@@ -51,7 +51,7 @@ def validation_summary() -> str:
 
 
 def validation_targets() -> str:
-    from postprocess.targets import TARGETS
+    from mpipd.post.targets import TARGETS
     rows = ["| quantity | unit | paper | experiment | range used |", "|---|---|---|---|---|"]
     for t in TARGETS:
         if t.kind == "information":

@@ -1,6 +1,6 @@
 # `make examples`: the worked examples of examples/ (examples/README.md, docs/examples.md),
 # each checked, run to its t_end on 2 ranks into runs/examples/NAME/ (--overwrite: a
-# rerun replaces the last one) and drawn by `postprocess fracture` on a section through
+# rerun replaces the last one) and drawn by `mpipd.post fracture` on a section through
 # the rock; each picture is copied to docs/img/examples/NAME.png for the docs page.
 # About 5-10 minutes on 2 cores.  `make example-NAME` makes one of them.
 EXAMPLES := single_hole paper_charge two_holes_delay jointed_rock
@@ -25,11 +25,11 @@ examples: $(addprefix example-,$(EXAMPLES))
 $(addprefix example-,$(EXAMPLES)): example-%: install
 	$(VENV)/bin/mpipd check examples/$*.toml > /dev/null
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run examples/$*.toml --out runs/examples/$* --overwrite
-	$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --out runs/examples/$*/fracture.png
+	$(MPIRUN) -n 2 $(PY) -m mpipd.post fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --out runs/examples/$*/fracture.png
 	mkdir -p docs/img/examples && cp runs/examples/$*/fracture.png docs/img/examples/$*.png
 	@for k in $(EXAMPLE_FRAMES_$*); do \
-	  echo "$(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --frame $$k --out runs/examples/$*/fracture_frame$$k.png"; \
-	  $(MPIRUN) -n 2 $(PY) -m postprocess fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --frame $$k --out runs/examples/$*/fracture_frame$$k.png || exit 1; \
+	  echo "$(MPIRUN) -n 2 $(PY) -m mpipd.post fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --frame $$k --out runs/examples/$*/fracture_frame$$k.png"; \
+	  $(MPIRUN) -n 2 $(PY) -m mpipd.post fracture runs/examples/$*/run.h5 --z $(EXAMPLE_Z_$*) --frame $$k --out runs/examples/$*/fracture_frame$$k.png || exit 1; \
 	  cp runs/examples/$*/fracture_frame$$k.png docs/img/examples/$*_frame$$k.png; \
 	done
 

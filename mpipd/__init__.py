@@ -12,6 +12,7 @@ which array):
 ``solver``      the step pipeline and time loop
 ``check``       ``mpipd check``: sizes, memory, stable time step, EOS warnings
 ``cli``         ``mpipd run | check | scenes``
+``post/``       reading run files after a run: ``python -m mpipd.post`` (report, figures)
 
 Importing mpipd never initialises MPI; the CLI and tests pass a communicator in.
 It does point numba's kernel cache at a directory keyed by the sources

@@ -22,14 +22,14 @@ for n in $(or $(5),$(MR_N)); do dt=$$($(PY) -c "print(2e-6/$$n)"); \
     --out $(3)/$(g)_$$n --overwrite --quiet --set time.dt=$$dt --set output.every=$$(($$n * $(or $(6),1))) \
     $($(2)_$(g)) || exit 1;) done
 for r in $(foreach g,$(1),$(foreach n,$(or $(5),$(MR_N)),$(g)_$(n))); do \
-  $(MPIRUN) -n 2 $(PY) -m postprocess report $(3)/$$r/run.h5 --out $(3)/$$r/report > /dev/null || exit 1; done
+  $(MPIRUN) -n 2 $(PY) -m mpipd.post report $(3)/$$r/run.h5 --out $(3)/$$r/report > /dev/null || exit 1; done
 endef
 
 .PHONY: multirate-verify
 multirate-verify: install
 	$(call dt_sweep,sr mr4 mr4full mr4fc1,MR_SET,runs/multirate)
 	$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_demo --out runs/multirate/mr2_100 --overwrite --quiet --set "time.multirate={max_ratio=2, safety=0.5}"
-	$(MPIRUN) -n 2 $(PY) -m postprocess report runs/multirate/mr2_100/run.h5 --out runs/multirate/mr2_100/report > /dev/null
+	$(MPIRUN) -n 2 $(PY) -m mpipd.post report runs/multirate/mr2_100/run.h5 --out runs/multirate/mr2_100/report > /dev/null
 	$(PY) benchmarks/multirate_compare.py --out studies/multirate/multirate_blast_demo.md --bands sr,mr4,mr4full,mr4fc1 --stats \
 	    $(foreach r,$(MR_RUNS),$(r)=runs/multirate/$(r))
 

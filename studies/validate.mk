@@ -1,6 +1,6 @@
 # `make validate`: the validation record (issue 15), studies/validation/record.md with
 # studies/validation/record/<case>/ (each run's report.json and key figures), re-created from
-# the run files in VALIDATE_RUNS: each is reported again (python -m postprocess report,
+# the run files in VALIDATE_RUNS: each is reported again (python -m mpipd.post report,
 # into report/ beside it) and the record is written from those report.json files,
 # with the hand-written diagnoses of VALIDATE_NOTES (if the file exists) verbatim.
 # A missing run file stops it first with one line naming the file and the command
@@ -111,8 +111,8 @@ VALIDATE_RANKS ?= 2
 VALIDATE_BASE ?= blast_paper_eq35
 
 validate: install
-	@$(PY) -m postprocess validate --check $(VALIDATE_RUNS)
-	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
+	@$(PY) -m mpipd.post validate --check $(VALIDATE_RUNS)
+	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m mpipd.post validate --out $(VALIDATE_OUT) \
 	    $(VALIDATE_RUNS) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES)) \
 	    $(if $(filter $(VALIDATE_BASE),$(notdir $(patsubst %/run.h5,%,$(VALIDATE_RUNS)))),--base $(VALIDATE_BASE))
 
@@ -216,7 +216,7 @@ resolution: install
 record: install
 	@mkdir -p runs
 	@$(PY) studies/validation/record_rows.py --rows runs/rows $(VALIDATE_RUNS) > runs/record_inputs.txt
-	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m postprocess validate --out $(VALIDATE_OUT) \
+	$(MPIRUN) -n $(VALIDATE_RANKS) $(PY) -m mpipd.post validate --out $(VALIDATE_OUT) \
 	    $$(cat runs/record_inputs.txt) $(if $(wildcard $(VALIDATE_NOTES)),--notes $(VALIDATE_NOTES)) \
 	    $(if $(filter $(VALIDATE_BASE),$(notdir $(patsubst %/run.h5,%,$(VALIDATE_RUNS)))),--base $(VALIDATE_BASE))
 
@@ -233,7 +233,7 @@ EL_SET_pf0.25 := --set materials.explosive.pressure_factor=0.25
 effective-load: install
 	$(foreach r,$(EL_RUNS),$(MPIRUN) -n 2 $(VENV)/bin/mpipd run blast_paper:slab --out runs/slab_$(r) \
 	    --overwrite --quiet --set output.every=100 $(EL_SET_$(r)) && \
-	    $(MPIRUN) -n 2 $(PY) -m postprocess report runs/slab_$(r)/run.h5 --out runs/slab_$(r)/report > /dev/null &&) true
+	    $(MPIRUN) -n 2 $(PY) -m mpipd.post report runs/slab_$(r)/run.h5 --out runs/slab_$(r)/report > /dev/null &&) true
 	$(PY) benchmarks/multirate_compare.py --out studies/model/effective_load_slab.md \
 	    --title "blast_paper:slab at the base's model (eq35), with Eq. 25's pressure (eos) and with the gas pressure x 0.5 and x 0.25; \`make effective-load\`" \
 	    $(foreach r,$(EL_RUNS),$(r)=runs/slab_$(r))

@@ -96,7 +96,7 @@ def test_bench_summary_side_by_side(first_microsecond, tmp_path):
 
     from conftest import child_env
     _, runs = first_microsecond
-    res = subprocess.run([sys.executable, "-m", "postprocess", "bench", str(runs["simultaneous"]),
+    res = subprocess.run([sys.executable, "-m", "mpipd.post", "bench", str(runs["simultaneous"]),
                           str(runs["long"]), "--labels", "sim,long", "--out", str(tmp_path / "b")],
                          capture_output=True, text=True, timeout=300, env=child_env())
     assert res.returncode == 0, res.stdout + res.stderr
@@ -123,7 +123,7 @@ def test_overbreak_depth_is_the_unbroken_damaged_run_from_the_row():
     then 5 % and a stray 50 % far back: the depth is the edge of the 12 % bin (4 mm),
     not the stray bin's; a first bin below 10 % gives the start; an all-damaged
     profile gives its last bin's edge."""
-    from postprocess.bench import OVERBREAK_FRACTION, overbreak_depth
+    from mpipd.post.bench import OVERBREAK_FRACTION, overbreak_depth
     assert OVERBREAK_FRACTION == 0.1
     frac = np.array([0.0, 0.5, 0.3, 0.12, 0.0, 0.05, 0.5])
     n = np.array([0, 10, 10, 25, 0, 20, 10])

@@ -1,10 +1,10 @@
-"""Crack orientation (postprocess/crack_orientation.py) on synthetic sections whose
+"""Crack orientation (mpipd/post/crack_orientation.py) on synthetic sections whose
 answer is known by construction: radial rays, a ring, an arc, random failure."""
 import numpy as np
 import pytest
 
-from postprocess import crack_orientation as co
-from postprocess import cracks
+from mpipd.post import crack_orientation as co
+from mpipd.post import cracks
 
 DX = 0.8e-3
 R_WALL, R_OUT = 3.2e-3, 72e-3
@@ -256,7 +256,7 @@ def test_ring_history_finds_a_ring_that_radial_damage_later_overruns():
     three sections is that length / 3 at frame 2's time."""
     from types import SimpleNamespace
 
-    from postprocess import analysis
+    from mpipd.post import analysis
     x, y = _section()
     rays = _rays(x, y, [10, 70, 130, 190, 250, 310])
     arc = _ring(x, y, 40e-3, np.radians(20), np.radians(60))

@@ -64,7 +64,7 @@ def test_an_example_parses_and_its_header_gives_the_commands(path):
     text = " ".join(header(path).replace("\\\n", " ").split())
     for command in (f"mpipd check examples/{name}.toml",
                     f"mpirun -n 2 mpipd run examples/{name}.toml --out runs/examples/{name}",
-                    f"mpirun -n 2 python -m postprocess fracture runs/examples/{name}/run.h5",
+                    f"mpirun -n 2 python -m mpipd.post fracture runs/examples/{name}/run.h5",
                     f"--out runs/examples/{name}/fracture.png"):
         assert command in text, f"{path.name}: the header lacks `{command}`"
     # every table of the scene is commented: a comment line or a trailing comment in it

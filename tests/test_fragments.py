@@ -1,4 +1,4 @@
-"""Fragments (postprocess.fragments, postprocess.sieve): a block cut by joints into
+"""Fragments (mpipd.post.fragments, mpipd.post.sieve): a block cut by joints into
 known pieces, the same fragments on 1, 2 and 3 ranks, and fits that recover a
 sampled distribution.  Expected values are computed here from the geometry."""
 import csv
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import child_env, run_cli
 
-from postprocess.sieve import fit_rosin_rammler, fit_swebrec, passing, percentile
+from mpipd.post.sieve import fit_rosin_rammler, fit_swebrec, passing, percentile
 
 DX = 1e-3
 RHO = 2660.0
@@ -47,7 +47,7 @@ def fragments(tmp_path, run, ranks, *extra):
     import subprocess
     import sys
     out = tmp_path / f"frag{ranks}"
-    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "postprocess",
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "mpipd.post",
            "fragments", str(run), "--out", str(out), "--min-points", "1", *extra]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=child_env())
     assert res.returncode == 0, res.stdout + res.stderr
@@ -143,7 +143,7 @@ def test_bad_input_is_one_line(tmp_path, cut_block):
                          ([str(run), "--frame", "5"], "--frame 5"),
                          ([str(run), "--parts", "rock"], "no part 'rock'"),
                          ([str(run), "--damage-threshold", "0.5"], "needs the damage field")):
-        res = subprocess.run([sys.executable, "-m", "postprocess", "fragments", *args,
+        res = subprocess.run([sys.executable, "-m", "mpipd.post", "fragments", *args,
                               "--out", str(tmp_path / "f")], capture_output=True, text=True,
                              timeout=120, env=child_env())
         lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
@@ -155,7 +155,7 @@ def test_damage_rule_breaks_bonds_between_two_damaged_points():
     """--damage-threshold: a bond counts as broken where both ends exceed it; bonds
     already broken stay broken (checked against a loop over the hand-built bonds)."""
     from mpipd.model.families import build_families
-    from postprocess.fragments import _break_damaged
+    from mpipd.post.fragments import _break_damaged
     rng = np.random.default_rng(5)
     x = rng.random((120, 3))
     fam = build_families(x, np.arange(120), np.full(120, 0.3), 90)

@@ -33,7 +33,7 @@ One run of the scheduler drives, side by side:
 
 SLURM holds a requeued job for 121 s before it may start again; the test
 releases it after a few seconds with ``scontrol update StartTime=now``, as an
-administrator can.  ``python -m postprocess summary`` stands in for ``report``.
+administrator can.  ``python -m mpipd.post summary`` stands in for ``report``.
 """
 import os
 import re

@@ -1,4 +1,4 @@
-"""postprocess.lattice_bias on synthetic sections of a square lattice (the demo's
+"""mpipd.post.lattice_bias on synthetic sections of a square lattice (the demo's
 geometry: dx 1 mm, R_b 3.2 mm, R_o 30 mm; ring = crack-density zone 2,
 12.13-21.07 mm): isotropic random failure is at the noise level (and the noise
 level is the mean amplitude), a cross along the axes gives |c_4|/c_0 near 1,
@@ -7,8 +7,8 @@ gives 0 although the lattice's own angular density is not uniform."""
 import numpy as np
 import pytest
 
-from postprocess import cracks
-from postprocess import lattice_bias as lb
+from mpipd.post import cracks
+from mpipd.post import lattice_bias as lb
 
 DX, R_WALL, R_OUT = 1e-3, 3.2e-3, 30e-3
 CENTER = (0.0, 0.0)

@@ -156,10 +156,10 @@ def test_rockmass_identical_on_1_2_3_ranks(rockmass_runs, fracture_runs):
     assert broken > 1000 and joint > 1000
     assert ref["fields/damage"][0].max() > 0.2             # the joints show at t = 0
     assert 0.17 < ref["geometry/strength_factor"].std() < 0.22     # m = 6: cv 0.194
-    # the postprocess reader cuts the jittered points by their lattice levels
+    # the mpipd.post reader cuts the jittered points by their lattice levels
     from mpi4py import MPI
 
-    from postprocess.reader import Run
+    from mpipd.post.reader import Run
     run = Run(rockmass_runs[1], MPI.COMM_SELF)
     try:
         np.testing.assert_allclose(np.unique(run.z_level), (np.arange(6) + 0.5) * 1e-3,

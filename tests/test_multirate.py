@@ -223,9 +223,9 @@ def test_a_probe_in_a_coarse_class_is_timed_at_its_updates():
     """A probe in the coarse half (class 2 of ratio 4) records every fine step, but its
     stress changes only at its class's updates: t_state = t - (n mod 4) dt, the stress
     is constant between updates, and the first arrival timed on one sample per state
-    (postprocess.arrivals.state_samples) matches the single-rate probe's, where the
+    (mpipd.post.arrivals.state_samples) matches the single-rate probe's, where the
     staircase timed at the recording steps comes late."""
-    from postprocess.arrivals import first_arrival, state_samples
+    from mpipd.post.arrivals import first_arrival, state_samples
     dt, t_end = 2.5e-8, 1.2e-5
     probe = ["probes=[{name='C', position=[0.07, 0.003, 0.003]}]"]
     rec = {}

@@ -308,7 +308,7 @@ def test_check_reports_memory_and_run_file_size():
     assert "run file: 0.00" in res.stdout and "4 frame(s) x 2 field(s) x 6144 points" in res.stdout
 
 
-# ----------------------------------------------------------------- postprocess (items 8, 9)
+# ----------------------------------------------------------------- mpipd.post (items 8, 9)
 
 @pytest.fixture(scope="module")
 def three_frames(tmp_path_factory):
@@ -319,8 +319,8 @@ def three_frames(tmp_path_factory):
     return out
 
 
-def postprocess(*args):
-    return subprocess.run([sys.executable, "-m", "postprocess", *args], capture_output=True,
+def post(*args):
+    return subprocess.run([sys.executable, "-m", "mpipd.post", *args], capture_output=True,
                           text=True, cwd=ROOT, timeout=120)
 
 
@@ -333,18 +333,18 @@ def postprocess(*args):
 ])
 def test_fracture_refuses_what_it_cannot_plot(three_frames, tmp_path, extra, needle):
     before = md5s(three_frames)
-    res = postprocess("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
+    res = post("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
                       *(extra if "--out" in extra else [*extra, "--out", str(tmp_path / "f.png")]))
     assert res.returncode == 2, res.stdout + res.stderr
     assert "Traceback" not in res.stderr
     lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("postprocess: error: ") and needle in lines[0], \
+    assert len(lines) == 1 and lines[0].startswith("mpipd.post: error: ") and needle in lines[0], \
         res.stderr
     assert not (tmp_path / "f.png").exists() and md5s(three_frames) == before
 
 
 def test_fracture_in_range_still_plots(three_frames, tmp_path):
-    res = postprocess("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
+    res = post("fracture", str(three_frames / "run.h5"), "--field", "stress_work",
                       "--frame", "-3", "--z", "0.008", "--out", str(tmp_path / "f.png"))
     assert res.returncode == 0, res.stdout + res.stderr
     assert (tmp_path / "f.png").stat().st_size > 0
@@ -353,7 +353,7 @@ def test_fracture_in_range_still_plots(three_frames, tmp_path):
 def test_report_out_on_a_file_is_one_line(three_frames, tmp_path):
     f = tmp_path / "file"
     f.write_text("keep")
-    res = postprocess("report", str(three_frames / "run.h5"), "--out", str(f))
+    res = post("report", str(three_frames / "run.h5"), "--out", str(f))
     assert res.returncode == 2, res.stdout + res.stderr
     assert "Traceback" not in res.stderr and "exists and is not a directory" in res.stderr
     assert f.read_text() == "keep"

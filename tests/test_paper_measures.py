@@ -10,9 +10,9 @@ import pytest
 from conftest import granite, make_scene, scene_dict
 
 from mpipd.input import scene as sc
-from postprocess import cracks
-from postprocess import tube as tb
-from postprocess.analysis import first_damage_frame
+from mpipd.post import cracks
+from mpipd.post import tube as tb
+from mpipd.post.analysis import first_damage_frame
 
 DX, R_WALL, R_OUT = 1e-3, 3e-3, 30e-3
 
@@ -133,7 +133,7 @@ def test_gas_outside_the_current_inner_surface():
 def test_tubes_of_the_builtin_scenes():
     """blast_demo has one tube around its charge; blast_bench three, each around its own
     charge; elastic_wave none (the measure is then absent, not an error)."""
-    from postprocess.model import _tubes
+    from mpipd.post.model import _tubes
 
     def tubes(name):
         scene, _ = sc.load(name)

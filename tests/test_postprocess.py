@@ -17,7 +17,7 @@ C_BAR = math.sqrt(9 * K * G / (3 * K + G) / RHO)
 
 
 def post(ranks, *args):
-    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "postprocess",
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "mpipd.post",
            *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120, cwd=ROOT,
                           env=child_env())
@@ -83,12 +83,12 @@ def test_fracture_png(tmp_path):
 def test_wave_speed_refuses_a_peak_at_the_first_frame(run_file):
     res = post(2, "wave-speed", str(run_file), "--stations", "0.0,0.1")   # the bump at t = 0
     assert res.returncode == 2
-    assert ("postprocess: error: the peak is at the first or last frame: the run is too "
+    assert ("mpipd.post: error: the peak is at the first or last frame: the run is too "
             "short or the station too far") in res.stderr
 
 
 def test_peak_time_vertex_and_edges():
-    from postprocess.fits import peak_time
+    from mpipd.post.fits import peak_time
     t = np.arange(8) * 0.5
     # samples of y = 1 - (t - 1.6)^2: the vertex exactly, with the largest sample's value
     y = 1.0 - (t - 1.6) ** 2
@@ -123,7 +123,7 @@ def test_jh2_envelope_of_the_pressure_stress_figure():
     at edot* = 1 by default: 433.16 MPa intact and 49.14 MPa fractured at p = 200 MPa
     (1.2 GPa * 1.9 (254/3700)^0.62 and 1.2 GPa * 0.25 (200/3700)^0.62)."""
     from mpipd.materials.jh2 import JH2
-    from postprocess.probe_metrics import jh2_envelope
+    from mpipd.post.probe_metrics import jh2_envelope
     m = JH2()
     si, sf = jh2_envelope(m, np.array([-m.T, 0.0, 200e6]))
     assert si[0] == 0.0 and sf[0] == 0.0 and sf[1] == 0.0

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import tomllib
 
-from postprocess.targets import TARGETS
-from postprocess.validation import judged
+from mpipd.post.targets import TARGETS
+from mpipd.post.validation import judged
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
@@ -39,7 +39,7 @@ def test_short():
 
 def test_status_table_is_the_records():
     """One row per judged quantity of the base row's report.json, in the record's order,
-    each with the verdict the record gives it now (postprocess.validation.judged)."""
+    each with the verdict the record gives it now (mpipd.post.validation.judged)."""
     doc = json.loads((ROOT / "studies" / "validation" / "record" / _base_case()
                       / "report.json").read_text())
     got = judged(doc)

@@ -1,4 +1,4 @@
-"""postprocess report / compare: every measure on synthetic run files with known
+"""mpipd.post report / compare: every measure on synthetic run files with known
 answers (in-process, one reading rank), the same numbers on 1 and 2 reading
 ranks, clear errors for foreign and truncated files, and the whole report on a
 short `blast_demo` run under mpirun -n 2."""
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, child_env, run_cli
 
-from postprocess.targets import TARGETS
+from mpipd.post.targets import TARGETS
 
 DX, R_WALL, R_OUT, NZ = 1e-3, 3e-3, 30e-3, 4
 C_WAVE, N_ATT, C_ATT = 4000.0, 0.8, 300e6          # synthetic wave: speed, attenuation
@@ -183,9 +183,9 @@ def put_probe(path, name, gid, sigma_rr, t=None, part=None, strength=None):
 def analyse(path):
     from mpi4py import MPI
 
-    from postprocess.analysis import analyse as run_analysis
-    from postprocess.model import load_model
-    from postprocess.reader import Run
+    from mpipd.post.analysis import analyse as run_analysis
+    from mpipd.post.model import load_model
+    from mpipd.post.reader import Run
     run = Run(path, MPI.COMM_SELF)
     try:
         model = load_model(run)
@@ -434,7 +434,7 @@ def test_crushed_zone_at_first_damage(tmp_path):
     Frames only at 0 and 10 µs: no frame within 1 µs of 4 µs, said in report.md."""
     from mpi4py import MPI
 
-    from postprocess.report import make_report
+    from mpipd.post.report import make_report
     x, part = lattice()
     r = np.hypot(x[:, 0], x[:, 1])
     rock = part == 1
@@ -473,7 +473,7 @@ def test_lattice_bias_of_a_cross_on_every_section(tmp_path):
     """A cross along the axes (|x| or |y| < 2 dx, 4 rows of 9 points per arm in the
     zone-2 ring 12-21 mm): a_4 ~ 0.96, far above the noise; 4 major cracks; report.md
     shows the table.  Without a failed point in the ring: not available per section."""
-    from postprocess.report_md import _lattice_bias
+    from mpipd.post.report_md import _lattice_bias
     x, part = lattice()
     cross = (part == 1) & ((np.abs(x[:, 0]) < 2 * DX) | (np.abs(x[:, 1]) < 2 * DX))
     write_run(tmp_path / "run.h5", failed=cross)
@@ -764,7 +764,7 @@ def test_first_arrival_threshold_is_the_first_pulses():
     first pulse's rise, where a linear ramp 0 -> 10 over [0.5, 1.5] reaches 1 at 0.6.
     With the spike before the pulse ends (a pulse that keeps rising) the threshold is
     10 % of the whole pulse's peak."""
-    from postprocess.arrivals import first_arrival
+    from mpipd.post.arrivals import first_arrival
     t = np.linspace(0.0, 8.0, 801)
     ramp = np.interp(t, [0.0, 0.5, 1.5, 2.5, 4.9, 5.0, 5.1, 8.0], [0, 0, 10, 0, 0, 100, 0, 0])
     a = first_arrival(t, ramp)
@@ -785,7 +785,7 @@ def test_a_probe_that_fails_in_its_first_pulse_has_no_arrival(tmp_path):
     the times out of order.  A has no arrival, says why, and the speed over B-G (clean
     half-sines) is c_P; the same ramp at a point that does not fail keeps its arrival,
     and the threshold study leaves A out as the judged fit does."""
-    from postprocess.arrivals import first_arrival
+    from mpipd.post.arrivals import first_arrival
     path = tmp_path / "run.h5"
     write_run(path)
     T, t0, t_fail = 2e-6, 0.5e-6, 3.0e-6
@@ -882,7 +882,7 @@ def test_arrivals_out_of_order_are_an_error(tmp_path):
     top of report.md and in report.json, and the targets row shows 'error'."""
     from mpi4py import MPI
 
-    from postprocess.report import make_report
+    from mpipd.post.report import make_report
     path = tmp_path / "run.h5"
     write_run(path)
 
@@ -940,7 +940,7 @@ def test_negative_energies_are_errors(tmp_path):
     ledger terms and the largest |balance| are reported."""
     from mpi4py import MPI
 
-    from postprocess.report import make_report
+    from mpipd.post.report import make_report
     path = tmp_path / "run.h5"
     write_run(path, v_rock=0.0, w_rock=-1.0)
     with h5py.File(path, "r+") as f:
@@ -975,7 +975,7 @@ def test_negative_energies_are_errors(tmp_path):
 
 
 def post(ranks, *args, timeout=120):
-    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "postprocess",
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), sys.executable, "-m", "mpipd.post",
            *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT,
                           env=child_env())
@@ -994,19 +994,19 @@ def test_foreign_and_truncated_files_are_one_line_errors(tmp_path):
     text.write_text("not hdf5\n")
     for bad, what in ((foreign, "not an mpipd run file"), (cut, "cannot open"),
                       (text, "cannot open"), (tmp_path / "none.h5", "cannot open")):
-        res = subprocess.run([sys.executable, "-m", "postprocess", "report", str(bad)],
+        res = subprocess.run([sys.executable, "-m", "mpipd.post", "report", str(bad)],
                              capture_output=True, text=True, timeout=60, cwd=ROOT, env=child_env())
         assert res.returncode == 2, (bad, res.stderr)
         lines = res.stderr.strip().splitlines()
-        assert len(lines) == 1 and lines[0].startswith("postprocess: error:") and what in lines[0]
+        assert len(lines) == 1 and lines[0].startswith("mpipd.post: error:") and what in lines[0]
         if bad not in (foreign, cut):
             continue
         res = post(2, "report", str(bad), "--out", str(tmp_path / "rep"))
         assert res.returncode == 2, (bad, res.stderr)
-        ours = [ln for ln in res.stderr.splitlines() if ln.startswith("postprocess")]
+        ours = [ln for ln in res.stderr.splitlines() if ln.startswith("mpipd.post")]
         assert len(ours) == 1 and what in ours[0] and "Traceback" not in res.stderr
     assert not (tmp_path / "rep").exists()
-    res = subprocess.run([sys.executable, "-m", "postprocess", "compare", str(good), str(foreign),
+    res = subprocess.run([sys.executable, "-m", "mpipd.post", "compare", str(good), str(foreign),
                           "--out", str(tmp_path / "cmp")], capture_output=True, text=True,
                          timeout=60, cwd=ROOT, env=child_env())
     assert res.returncode == 2 and "not an mpipd run file" in res.stderr

@@ -238,7 +238,7 @@ def test_a_charge_along_x_gives_the_z_charges_answer_mirrored(tmp_path):
     assert res.returncode == 0, res.stdout + res.stderr
     restart_matches(d / "checkpoint.h5", runs["x", 2], ("fields/u", "fields/damage"), ranks=3)
     # the bench measures need vertical holes: one line, status 2, for a hole along x
-    res = subprocess.run([sys.executable, "-m", "postprocess", "bench", str(runs["x", 2])],
+    res = subprocess.run([sys.executable, "-m", "mpipd.post", "bench", str(runs["x", 2])],
                          capture_output=True, text=True, timeout=120, env=child_env(),
                          cwd=tmp_path)
     assert res.returncode == 2 and "holes along z" in res.stderr, res.stderr

@@ -1,5 +1,5 @@
-"""postprocess validate: the validation record from synthetic report directories
-(report.json in the layout of `postprocess report`, tiny PNGs) with known values —
+"""mpipd.post validate: the validation record from synthetic report directories
+(report.json in the layout of `mpipd.post report`, tiny PNGs) with known values —
 one table row per target, values and verdicts in their run's columns, figures
 copied and downscaled, the lattice-bias table when a report has one, the notes
 verbatim, and a missing input: one line, exit status 2, nothing written."""
@@ -13,10 +13,10 @@ import pytest
 from conftest import ROOT, child_env
 from PIL import Image
 
-from postprocess import validation
-from postprocess.__main__ import main
-from postprocess.crack_orientation import CLASSES
-from postprocess.targets import TARGETS, verdict
+from mpipd.post import validation
+from mpipd.post.__main__ import main
+from mpipd.post.crack_orientation import CLASSES
+from mpipd.post.targets import TARGETS, verdict
 
 CONSISTENCY = (6794.0, 15511.0)
 BIG, SMALL = (1800, 600), (300, 200)        # figure sizes (px): one wider than 900
@@ -43,7 +43,7 @@ def outside(t):
 
 def report_json(case, values, lattice_bias=None, figures=("fig09_fracture_faces",
                                                           "fig12_crack_density")):
-    """A report.json like `postprocess report` writes (only the blocks the record reads,
+    """A report.json like `mpipd.post report` writes (only the blocks the record reads,
     in their layout): ``values`` key -> number, or a string = the not-available reason."""
     rows = []
     for t in TARGETS:
@@ -124,7 +124,7 @@ def test_record(two_reports, capsys):
     assert rc == 0, capsys.readouterr().err
     md = (tmp / "docs" / "validation.md").read_text()
     assert md.startswith("# Validation record")
-    assert f"`python -m postprocess validate --out {out} {a} {b} --notes {notes}`" in md
+    assert f"`python -m mpipd.post validate --out {out} {a} {b} --notes {notes}`" in md
 
     rows = table(md, "## Targets")
     head, body = rows[0], rows[2:]
@@ -363,7 +363,7 @@ def test_make_sensitivity_sets_each_case_beside_the_base(tmp_path):
 
 
 def test_named_cases_list_the_rows_that_ran_them(tmp_path, capsys, monkeypatch):
-    """The record's "Named cases" section (postprocess.case_coverage): each case of the
+    """The record's "Named cases" section (mpipd.post.case_coverage): each case of the
     rows' scene with the rows whose report.json names it, the time each reached
     against the case's t_end (read here from the scene file), what it set beyond the
     case's own overrides or lacks of them, and whether its scene changed since its
@@ -371,7 +371,7 @@ def test_named_cases_list_the_rows_that_ran_them(tmp_path, capsys, monkeypatch):
     reached t_end."""
     import tomllib
 
-    from postprocess import case_coverage
+    from mpipd.post import case_coverage
     scenes = ROOT / "mpipd" / "input" / "scenes"
     base = tomllib.loads((scenes / "blast_demo.toml").read_text())
     cases = tomllib.loads((scenes / "cases" / "blast_demo.toml").read_text())
@@ -421,7 +421,7 @@ def test_named_cases_read_the_scene_at_a_commit_with_git():
     commit, parsed); an unknown commit gives None, so the row is "not checked"."""
     import tomllib
 
-    from postprocess import case_coverage
+    from mpipd.post import case_coverage
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
                           text=True, check=True).stdout.strip()
     for rel in ("blast_demo.toml", "cases/blast_demo.toml"):

@@ -2,7 +2,7 @@
 written, every existing file unchanged) -- `mpipd check` refusing a probe outside
 the body as `mpipd run` does, a box thinner than half a lattice spacing, an initial
 or boundary region with no point, a charge lit from outside it or after t_end, a
-checkpoint whose data changed after it was written -- and `postprocess summary` on
+checkpoint whose data changed after it was written -- and `mpipd.post summary` on
 a run that stopped early (the items already fixed by a8b924f are in test_caught.py:
 the BOM, a missing path with ':', --stop-after beyond the end, the quoted hint)."""
 import shutil
@@ -181,14 +181,14 @@ def test_checksums_are_the_same_for_any_split_of_the_rows():
         assert row_checksum(moved, keys, 7) != whole
 
 
-# ----------------------------------------------------------------- postprocess
+# ----------------------------------------------------------------- mpipd.post
 
 def test_summary_prints_only_the_written_frames(stopped):
     import subprocess
     import sys
 
     from conftest import child_env
-    res = subprocess.run([sys.executable, "-m", "postprocess", "summary",
+    res = subprocess.run([sys.executable, "-m", "mpipd.post", "summary",
                           str(stopped / "run.h5")], capture_output=True, text=True,
                          timeout=120, env=child_env())
     assert res.returncode == 0, res.stderr

@@ -18,7 +18,7 @@ References, both computed here:
   -sigma_rr records over A, B, C, relative to each probe's single-rate peak, with the
   probes' records taken at their states' times (``t_state``; a coarse probe holds its
   stress between updates) and interpolated onto the single-rate times; and the
-  difference of the first arrivals (``postprocess.arrivals``) in units of dt.
+  difference of the first arrivals (``mpipd.post.arrivals``) in units of dt.
 
 Each row also gives the ledger's largest |balance| at the coarse steps after the first
 µs (before it the load has put in almost nothing, and the balance, relative to the
@@ -80,7 +80,7 @@ class BoreholeMultirate:
         from diagnoses.wave_speed import closed_form
 
         from mpipd.input.loads import BoreholePressure
-        from postprocess.arrivals import first_arrival, state_samples
+        from mpipd.post.arrivals import first_arrival, state_samples
         rows, ref = [], None
         for ratio in RATIOS:
             d = scene_dict(dx, ratio)

@@ -7,7 +7,7 @@
 # jobs/README.md), sources this file and calls one of
 #   mpipd_job_run          one run: MPIPD_SCENE -> MPIPD_OUT
 #   mpipd_job_sweep        one case of a job array: MPIPD_OUT/<case>
-#   mpipd_job_postprocess  python -m postprocess on finished run folder(s)
+#   mpipd_job_postprocess  python -m mpipd.post on finished run folder(s)
 #
 # One link of a chain:
 #   1. a deadline for the job's own timer: the wall-time limit the scheduler
@@ -407,7 +407,7 @@ mpipd_job_sweep() {
   mpipd_chain_run "$out/${_CASE_NAMES[i]}" "${_CASE_SCENES[i]}" ${MPIPD_ARGS:-} ${_CASE_ARGS[i]}
 }
 
-# mpipd_job_postprocess [RUN_DIR...]: python -m postprocess on each finished run
+# mpipd_job_postprocess [RUN_DIR...]: python -m mpipd.post on each finished run
 mpipd_job_postprocess() {
   trap - USR1 TERM
   mpipd_job_start
@@ -438,9 +438,9 @@ mpipd_job_postprocess() {
     fi
     args=${MPIPD_POSTPROCESS_ARGS-"--out {run}/report"}
     args=${args//\{run\}/$run}
-    echo "mpipd-job: $MPIPD_LAUNCHER python -m postprocess $MPIPD_POSTPROCESS $run/run.h5 $args"
+    echo "mpipd-job: $MPIPD_LAUNCHER python -m mpipd.post $MPIPD_POSTPROCESS $run/run.h5 $args"
     # shellcheck disable=SC2086
-    $MPIPD_LAUNCHER "$(command -v python)" -m postprocess $MPIPD_POSTPROCESS "$run/run.h5" $args \
+    $MPIPD_LAUNCHER "$(command -v python)" -m mpipd.post $MPIPD_POSTPROCESS "$run/run.h5" $args \
       > >(tee "$run/postprocess.log") 2>&1 || rc=1
     wait
   done

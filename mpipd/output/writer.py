@@ -190,7 +190,7 @@ class Writer:
         dp = geo.create_dataset("part", (N,), "i4")
         dp.attrs["names"] = [q.name for q in scene.parts]
         self._write(dp, np.s_[g0:g1], p.part[:n])
-        if any(q.jitter > 0 for q in scene.parts):     # the lattice levels (postprocess)
+        if any(q.jitter > 0 for q in scene.parts):     # the lattice levels (mpipd.post)
             t, (a0, b0) = sim.slabs.table, sim.slabs.owned(sim.team.rank)
             self._write(geo.create_dataset("z_level", (N,), "f8"), np.s_[g0:g1],
                         np.repeat(t.z[a0:b0], t.count[a0:b0]))

@@ -12,8 +12,8 @@ from pathlib import Path
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from postprocess.model import load_model  # noqa: E402
-from postprocess.reader import Run  # noqa: E402
+from mpipd.post.model import load_model  # noqa: E402
+from mpipd.post.reader import Run  # noqa: E402
 
 
 def open_run(path, script):

@@ -6,7 +6,7 @@ From a run file, serially (rank 0 of the run file's reader; run it on 1 rank):
 
 * **The wall probe's peaks**, every step (what the wall layer carried), if it has one.
 * **Crushed zone by mode** (the last frame, on the report's three crack sections):
-  postprocess.cracks.crushed_zone with the points' failure modes — the share of JH2
+  mpipd.post.cracks.crushed_zone with the points' failure modes — the share of JH2
   plastic (D >= 1), JH2 tensile and tension-model failures among the failed points of
   its rings.
 * **Pressure before failure** (needs ``failure_mode`` and ``pressure`` at frames close
@@ -33,8 +33,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diag_run import open_run  # noqa: E402
 
 from mpipd.kernels.layout import MODE_NAMES  # noqa: E402
-from postprocess import cracks  # noqa: E402
-from postprocess.analysis import crack_sections  # noqa: E402
+from mpipd.post import cracks  # noqa: E402
+from mpipd.post.analysis import crack_sections  # noqa: E402
 
 
 def crushed_by_mode(run, model, last):

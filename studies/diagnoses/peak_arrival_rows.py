@@ -1,7 +1,7 @@
 """The paper's peak-arrival speed on the direct wave for every row of the record that
 stores its probes' first-pulse peak times (studies/validation/notes.md §38, §44).
 
-postprocess.probe_metrics._first_pulse_peak_arrival, the function a report runs, applied
+mpipd.post.probe_metrics._first_pulse_peak_arrival, the function a report runs, applied
 to the ``radial_stress.points`` each row's report.json holds: rows reported before the
 measure existed but after §38's first-pulse peaks get the same value a report made now
 would give them.  Beside it, the judged first-arrival speed.  Reads files only.
@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from postprocess.probe_metrics import _first_pulse_peak_arrival  # noqa: E402
+from mpipd.post.probe_metrics import _first_pulse_peak_arrival  # noqa: E402
 
 
 def main():

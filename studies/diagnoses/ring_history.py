@@ -2,9 +2,9 @@
 
 Diagnosis of studies/validation/notes.md §45 (Table 3's case 5: "some small ring cracks
 (spalling)").  The report measures ring arcs and failed rings once, at the last frame
-(postprocess.crack_orientation.measure on the three crack sections); a ring that forms and
+(mpipd.post.crack_orientation.measure on the three crack sections); a ring that forms and
 is later overrun by radial damage does not show there.  The report now carries the same
-measure at every frame (postprocess.analysis.ring_history); this script prints it from
+measure at every frame (mpipd.post.analysis.ring_history); this script prints it from
 --from-us on, for a run file whose report predates it: per frame and section, the number
 of ring arcs, their total length and radii, and the failed rings.
 
@@ -17,8 +17,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diag_run import open_with_option  # noqa: E402
 
-from postprocess import crack_orientation, cracks  # noqa: E402
-from postprocess.analysis import crack_sections, ring_history  # noqa: E402
+from mpipd.post import crack_orientation, cracks  # noqa: E402
+from mpipd.post.analysis import crack_sections, ring_history  # noqa: E402
 
 
 def main():

@@ -3,7 +3,7 @@
 Diagnosis of studies/validation/notes.md ("first-arrival wave speed").  For each run
 file (a scene like ``wave_ring_elastic.toml``: an elastic rock ring, a
 ``borehole_pressure`` pulse, probes A-C), prints the arrival times and the
-first-arrival speed at each threshold fraction of ``postprocess.arrivals.STUDY``,
+first-arrival speed at each threshold fraction of ``mpipd.post.arrivals.STUDY``,
 and the peak-arrival speed, beside the same measures applied to the exact
 plane-strain response of an infinite elastic solid with a cylindrical cavity of the
 wall radius under the same pressure history:
@@ -42,8 +42,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from mpipd.input.loads import BoreholePressure  # noqa: E402
 from mpipd.input.scene import parse  # noqa: E402
 from mpipd.output.writer import short_commit  # noqa: E402
-from postprocess import arrivals  # noqa: E402
-from postprocess.model import split_scene_text  # noqa: E402
+from mpipd.post import arrivals  # noqa: E402
+from mpipd.post.model import split_scene_text  # noqa: E402
 
 PROBES = ("A", "B", "C", "D", "E", "F", "G")
 HERE = Path(__file__).resolve().parent

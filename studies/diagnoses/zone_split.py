@@ -5,7 +5,7 @@ rule counts each failed point on a section as a crack of its own dx,
 
     density_k = sum over failed points i of zone k of dx_i / A_k
 
-(postprocess.cracks.crack_density), so an annulus that is failed through adds
+(mpipd.post.cracks.crack_density), so an annulus that is failed through adds
 A_annulus / (dx A_k) to zone k: the finer its lattice, the more it reads.  This script
 splits each zone at ``--split-mm`` (radius from the borehole's axis) on the report's three
 crack sections at the last frame and prints, for each part, its failed and total points,
@@ -24,8 +24,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diag_run import open_with_option  # noqa: E402
 
-from postprocess import cracks  # noqa: E402
-from postprocess.analysis import crack_sections  # noqa: E402
+from mpipd.post import cracks  # noqa: E402
+from mpipd.post.analysis import crack_sections  # noqa: E402
 
 
 def split_density(x, y, failed, center, dx, r_wall, r_out, r_split):

@@ -7,7 +7,7 @@ the cubic lattice, with jitter, with Weibull strength and with both, over seeds.
 Runs (2 ranks each, ``--overwrite``): ``lattice_0`` (the built-in scene: no seed to
 vary) and ``jitter_S``, ``weibull_S``, ``rockmass_S`` for each seed S (the named
 cases blast_demo:jitter, :weibull, :rockmass with parts.2.jitter_seed = S and the
-heterogeneity's seed = S), then ``postprocess report`` of each, then the table
+heterogeneity's seed = S), then ``mpipd.post report`` of each, then the table
 (benchmarks/multirate_compare.py --bands --stats): every run's row, and each
 group's mean ± standard deviation and range of the report's targets (crack density
 per zone against the experiment's ranges, radial cracks, crushed zone, ...) and of
@@ -67,7 +67,7 @@ def main(argv=None):
         print(" ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
         subprocess.run([*shlex.split(args.mpirun), "-n", str(args.ranks), sys.executable, "-m",
-                        "postprocess", "report",
+                        "mpipd.post", "report",
                         str(d / "run.h5"), "--out", str(d / "report")], check=True,
                        stdout=subprocess.DEVNULL)
     title = ("# The rock mass on blast_demo: lattice, jitter, Weibull strength, both "

@@ -1,7 +1,7 @@
 """The inputs of the validation record on a machine that lacks some of its run files
 (`make record`, studies/validate.mk).
 
-For each run file RUNS/<case>/run.h5 given, one input of ``postprocess validate``
+For each run file RUNS/<case>/run.h5 given, one input of ``mpipd.post validate``
 is printed, one per line:
 
 * ``RUNS/<case>/report``, if its report.json is there (the run's own report);

@@ -8,7 +8,7 @@
 * ``data`` — the gathered sections, the axial plane and the probes, on rank 0
   only (what the figures draw).
 
-Fracture measures (:mod:`postprocess.cracks`) use the last frame on three
+Fracture measures (:mod:`mpipd.post.cracks`) use the last frame on three
 sections, the two end faces and mid-thickness (paper §3.2, Fig. 12); the
 headline is the mean over the three sections for crack density and the crushed
 zone, and the median for the count of major radial cracks (information beside the
@@ -16,10 +16,10 @@ paper's measures below); the paper's own measures:
 
 * major radial cracks (judged) on Fig. 11's sections, 5 mm from the detonation face,
   mid-thickness and 5 mm from the far face, failed points linked only as lattice
-  neighbours (1.5 dx: :data:`postprocess.cracks.LATTICE_LINK`, why there), at the
+  neighbours (1.5 dx: :data:`mpipd.post.cracks.LATTICE_LINK`, why there), at the
   last frame; the headline is the median of the three sections' counts;
 * the crushed zone at first damage (judged): the same rule
-  (:func:`postprocess.cracks.crushed_zone`) at the frame nearest 4 µs (Fig. 9a:
+  (:func:`mpipd.post.cracks.crushed_zone`) at the frame nearest 4 µs (Fig. 9a:
   "damage is first observed surrounding the borehole as all points within a zone of
   approximately one radius of the borehole are damaged"), if one lies within 1 µs of
   it, on the same three sections; judged on the detonation end face, the view of
@@ -27,16 +27,16 @@ paper's measures below); the paper's own measures:
   the three beside it; the last frame's mean (above) is information.
 
 The crack orientation
-(:mod:`postprocess.crack_orientation`: radial, oblique, circumferential, and the
+(:mod:`mpipd.post.crack_orientation`: radial, oblique, circumferential, and the
 ring arcs) on the same sections, and the ring arcs again at every saved frame (a ring that
 forms and is overrun shows only there).  The lattice bias
-(:mod:`postprocess.lattice_bias`: 4- and 8-fold Fourier amplitudes of the failed
+(:mod:`mpipd.post.lattice_bias`: 4- and 8-fold Fourier amplitudes of the failed
 points' angles in the zone-2 ring) is measured on every gathered section at the
 last frame.
 
-Peaks (gas, wall, PPV profile) are over every step (:mod:`postprocess.peaks`, the
+Peaks (gas, wall, PPV profile) are over every step (:mod:`mpipd.post.peaks`, the
 probes), never over the saved frames alone; impossible values are gathered in
-``errors`` (:mod:`postprocess.errors`) and shown as errors, not numbers.
+``errors`` (:mod:`mpipd.post.errors`) and shown as errors, not numbers.
 """
 from __future__ import annotations
 
@@ -89,7 +89,7 @@ def profile_frames(times, n=4) -> list[int]:
 
 
 def ring_history(sections, model, frames, times, r_min_mm=None) -> dict:
-    """Ring arcs frame by frame: :func:`postprocess.crack_orientation.measure` on the
+    """Ring arcs frame by frame: :func:`mpipd.post.crack_orientation.measure` on the
     crack sections (CRACK_SECTIONS) at each of ``frames``, as the report applies it at
     the last frame.  A ring that forms and is later overrun by radial damage (Table 3's
     case 5, studies/validation/notes.md §45) shows here and not at the last frame.
@@ -132,7 +132,7 @@ def ring_history(sections, model, frames, times, r_min_mm=None) -> dict:
 def _fig11(data_sections, model, last, fig11) -> dict:
     """Major radial cracks on Fig. 11's sections (``fig11``: name -> the gathered
     section holding its level), failed points linked as lattice neighbours
-    (:data:`postprocess.cracks.LATTICE_LINK` dx), at the last frame; the median of the
+    (:data:`mpipd.post.cracks.LATTICE_LINK` dx), at the last frame; the median of the
     sections' counts."""
     per = {}
     for name in FIG11_SECTIONS:
@@ -157,7 +157,7 @@ def _fig11(data_sections, model, last, fig11) -> dict:
 
 
 def _first_damage(data_sections, model, first) -> dict:
-    """The crushed zone (:func:`postprocess.cracks.crushed_zone`) at the frame nearest
+    """The crushed zone (:func:`mpipd.post.cracks.crushed_zone`) at the frame nearest
     4 µs (``first``: :func:`first_damage_frame`) on CRACK_SECTIONS; the headline is
     the detonation end face's (Fig. 9a's view), the mean of the sections beside it."""
     if "not_available" in first:
@@ -265,7 +265,7 @@ def _ppv_radius(ppv, profile) -> dict:
 def crack_sections(run, model, requests) -> dict | None:
     """The crack sections (CRACK_SECTIONS: the end faces and mid-thickness) of the
     run's rock with ``requests`` = [(field, frame)], as
-    :func:`postprocess.sections.gather_sections` gives them (rank 0; None elsewhere)."""
+    :func:`mpipd.post.sections.gather_sections` gives them (rank 0; None elsewhere)."""
     zoned = secs.named_levels(secs.zone_levels(run, model), model)
     return secs.gather_sections(run, model, {n: z for n, z in zoned.items()
                                              if n in CRACK_SECTIONS}, requests)
@@ -453,7 +453,7 @@ def _tube_basis(tc, key="outside") -> str:
 
 def target_bounds(m: dict) -> dict:
     """key -> (lo, hi) of the consistency rows, from the run's own explosive_reference
-    (also applied to a report.json by :mod:`postprocess.validation`)."""
+    (also applied to a report.json by :mod:`mpipd.post.validation`)."""
     ref = m["explosive_reference"]
     return {"peak_gas_pressure": tuple(ref["consistency_MPa"])
             if "consistency_MPa" in ref else None}

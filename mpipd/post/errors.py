@@ -2,11 +2,11 @@
 of report.json.  Each is ``{"measure", "message"}``; the affected value itself is
 an ``{"error": ...}`` in its own block and is never shown as a number.
 
-Collected: a probe whose point is not in its part (:mod:`postprocess.probe_metrics`),
-first-arrival times that do not increase with distance (:mod:`postprocess.arrivals`),
+Collected: a probe whose point is not in its part (:mod:`mpipd.post.probe_metrics`),
+first-arrival times that do not increase with distance (:mod:`mpipd.post.arrivals`),
 a negative energy in the rock and explosive points inside the rock
-(:mod:`postprocess.volume`), a negative ledger term
-that must be non-negative (:mod:`postprocess.ledger`), and any other measure that
+(:mod:`mpipd.post.volume`), a negative ledger term
+that must be non-negative (:mod:`mpipd.post.ledger`), and any other measure that
 came out as an error.
 """
 from __future__ import annotations

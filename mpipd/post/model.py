@@ -20,7 +20,7 @@ R_b is the innermost zone's inner radius, R_o the outermost zone's radius and
 ``wall_dx`` the innermost zone's dx (the wall layer is r < R_b + wall_dx);
 ``rock`` is the reference zone (the one named ``rock``, or the first): the sections
 are named by its z levels and every other zone joins them at its own nearest level
-(:mod:`postprocess.sections`); ``zone_dx`` and ``zone_horizon`` give each zone's dx and
+(:mod:`mpipd.post.sections`); ``zone_dx`` and ``zone_horizon`` give each zone's dx and
 horizon (from the scene; else dx = V^(1/3) of the zone's points and 3 dx).
 The charge is the part of a ``jwl`` material (or ``charge``); ``explosive`` is its
 material (JWL constants, Table 2) when the scene parses.

@@ -74,7 +74,7 @@ def render(doc) -> str:
     L += _errors(doc.get("errors", []))
     L += ["", "## Targets (paper §3.2–3.5, DESIGN §8)", "",
           "The verdict compares the run's value with the range in the 'range used' column; "
-          "the ranges are fixed constants (`postprocess/targets.py`), not tuned to runs.  The "
+          "the ranges are fixed constants (`mpipd/post/targets.py`), not tuned to runs.  The "
           "explosive's row is a physical consistency check against its own JWL constants "
           "(Table 2); 'information' rows are shown, not judged.  Peaks are over every time "
           "step (per-point peak fields or the probes), never over the saved frames alone.", ""]
@@ -187,7 +187,7 @@ def _fig11(f) -> list[str]:
           "(max-norm: nearest and diagonal neighbours), not within a horizon: cracks two or three "
           "spacings apart, and the late boundary damage that reaches a crack, are separate cracks "
           "on the section but lie within one horizon, which would merge them "
-          "(`postprocess/cracks.py`).  A crack is major when it runs from zone 1 into the outer "
+          "(`mpipd/post/cracks.py`).  A crack is major when it runs from zone 1 into the outer "
           "2 dx.  Headline: the median of the sections' counts.", "",
           "| Fig. 11 section | z (mm) | major radial cracks | angles (deg) | boundary arcs |",
           "|---|---|---|---|---|"]
@@ -224,9 +224,9 @@ def _orientation(fr) -> list[str]:
         return L + ["Not available: no crack section.", ""]
     if not all("orientation" in s for s in fr["sections"].values()):
         return L + ["Not available: no orientation in this report (made before "
-                    "postprocess/crack_orientation.py).", ""]
+                    "mpipd/post/crack_orientation.py).", ""]
     o = next(iter(fr["sections"].values()))["orientation"]
-    L += [f"Rule: {o['rule']} (`postprocess/crack_orientation.py`).  Crack length per class "
+    L += [f"Rule: {o['rule']} (`mpipd/post/crack_orientation.py`).  Crack length per class "
           "(mm, failed points × dx) in each zone; the circumferential density is its length "
           "over the ring's area, as in Fig. 12.", "",
           "| section | zone | failed points | " + " | ".join(CLASSES)
@@ -276,7 +276,7 @@ def _lattice_bias(lb) -> list[str]:
           "fraction against the angle, with the lattice's own angular density of points "
           "subtracted (0 for an isotropic pattern; 1 for thin cracks on the axes or on the "
           "diagonals only); noise = the mean a_m of as many failed points placed regardless "
-          "of angle (`postprocess/lattice_bias.py`).", "",
+          "of angle (`mpipd/post/lattice_bias.py`).", "",
           "| section | ring (mm) | failed points | a_4 | a_8 | noise | a_4 / noise | "
           "4-fold direction (deg; 0 axes, 45 diagonals) | major radial cracks |",
           "|---|---|---|---|---|---|---|---|---|"]
@@ -471,7 +471,7 @@ def _tube(doc) -> list[str]:
     if t is None or _na(t):
         return []
     L = ["### Gas containment by the tube", "",
-         f"Rule (`postprocess/tube.py`): {t['rule']}.  Tube(s): "
+         f"Rule (`mpipd/post/tube.py`): {t['rule']}.  Tube(s): "
          + ", ".join(f"{n} ({g} gas points, {i} inner-layer points, {b[0]} x {b[1]} bins in "
                      "z x angle)" for n, g, i, b in zip(t["tubes"], t["gas_points"],
                                                        t["inner_layer_points"], t["bins"]))

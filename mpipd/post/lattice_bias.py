@@ -1,8 +1,8 @@
 """Lattice bias of the crack pattern on one section (issue 15): do the cracks
 prefer the cubic lattice's axes and diagonals?
 
-Ring.  The failed points (:func:`postprocess.cracks.failed_points`) are taken in
-the ring of crack-density zone 2 (:func:`postprocess.cracks.zone_edges`),
+Ring.  The failed points (:func:`mpipd.post.cracks.failed_points`) are taken in
+the ring of crack-density zone 2 (:func:`mpipd.post.cracks.zone_edges`),
 
     R_b + w <= r < R_b + 2 w,     w = (R_o - R_b) / 3,
 
@@ -53,7 +53,7 @@ Rayleigh distributed with mean (sqrt(pi)/2) sqrt(E |X_m|^2):
 (sigma_m^2 taken as 1: an upper bound within |mu_m|^2 ~ 1e-4).  Under H0,
 P(a_m > 3 noise) = exp(-9 pi / 4) ~ 1e-3.
 
-Major radial cracks: :func:`postprocess.cracks.radial_cracks` on the section.
+Major radial cracks: :func:`mpipd.post.cracks.radial_cracks` on the section.
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 The paper's copper tube "passes the blasting load onto the rock" (§3.1, Fig. 6);
 an intact tube holds the gas, so no gas point should lie outside it while the tube
 is whole.  The tube is a part of the scene that holds a charge
-(:attr:`postprocess.model.Model.tubes`: an annulus around a ``jwl`` cylinder on the
+(:attr:`mpipd.post.model.Model.tubes`: an annulus around a ``jwl`` cylinder on the
 same axis); the gas is the points of the charges it holds (material model
 ``jwl``).  Current positions are y = x + u of the frame (``/geometry/x`` and
 ``/fields/u``: the gas is updated-Lagrangian, its ``u`` is its current position
@@ -30,7 +30,7 @@ Per saved frame and tube:
 The bins' means are formed from the inner layer gathered to every rank in gid
 order, so the counts do not depend on the number of reading ranks.  With an intact
 tube ``outside`` is 0 at every frame; the report judges it so
-(:data:`postprocess.targets.TARGETS` ``gas_outside_tube``) and gives the first
+(:data:`mpipd.post.targets.TARGETS` ``gas_outside_tube``) and gives the first
 frame where it is not.
 """
 from __future__ import annotations

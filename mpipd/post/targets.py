@@ -10,7 +10,7 @@ are constants here: nothing in the analysis adapts them, or the measures, to a r
 Two rows are not bands of the paper's numbers.  The explosive's peak pressure is a
 physical consistency check (``kind = "consistency"``): it must lie between the
 constant-volume explosion pressure p(1, e0) and the Chapman–Jouguet pressure, both
-computed from the run's own JWL constants (:mod:`postprocess.explosive`): the
+computed from the run's own JWL constants (:mod:`mpipd.post.explosive`): the
 paper's "up to 1800 MPa" (mpipd.materials.jwl.PAPER_PEAK_PRESSURE) contradicts its
 Table 2 (p_CJ = 15.5 GPa), so it is shown but not judged.  The wall pressure, the
 peak-arrival wave speed and the direct wave's peaks (the first pulse's, beside the
@@ -23,9 +23,9 @@ major radial cracks on Fig. 11's sections linked as lattice neighbours
 nearest 4 µs of Fig. 9(a) (``crushed_zone_first_damage``).  The former rows,
 ``major_radial_cracks`` (end faces and mid-thickness, linked within the horizon)
 and ``crushed_zone`` (last frame), are information since 2026-12; a report made
-before then has them judged (``postprocess validate`` shows its stored verdict
+before then has them judged (``mpipd.post validate`` shows its stored verdict
 beside today's).  The gas outside the copper tube (``gas_outside_tube``,
-:mod:`postprocess.tube`) must be 0 at every frame (an intact tube holds the gas);
+:mod:`mpipd.post.tube`) must be 0 at every frame (an intact tube holds the gas);
 the gas beyond the tube's ends (venting) is information.
 
 A value is a number, ``{"not_available": reason}`` or ``{"error": message}`` (an

@@ -41,7 +41,7 @@ linking merges them, or makes a boundary crack that never reached the borehole a
 leave a gap wider than one spacing on the section falls apart there and, if no
 piece runs from zone 1 to the band, is not counted.  The paper counts on Fig. 11's
 sections, 5 mm from the detonation face, mid-thickness and 5 mm from the far face
-(:data:`postprocess.sections.FIG11`); the report's headline is the median of the
+(:data:`mpipd.post.sections.FIG11`); the report's headline is the median of the
 three sections' counts (robust to one section where a crack is split or joined; an
 integer when the three are).
 

@@ -23,7 +23,7 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
   whose peak is the last recorded step (the wave has not passed it yet) is shown
   but left out of the fits and of the wave speed.
 * The direct wave's peak (information): the peak of each probe's **first pulse**
-  (:mod:`postprocess.arrivals`: from the first arrival until -sigma_rr falls below half
+  (:mod:`mpipd.post.arrivals`: from the first arrival until -sigma_rr falls below half
   its running maximum), and p = C d^-n fitted over those.  The whole-run peak above is
   the largest compression at the point over every step; where a later event (the
   crushed zone's compression, a reflection, a crack reaching the point) exceeds the
@@ -31,7 +31,7 @@ must be rock points.  A probe that fails carries ``error`` and gives no numbers.
   of reducing magnitude, whose first is the direct wave.  A probe whose point fails
   during its first pulse, or whose first pulse has not ended by the end of the
   record, has no first-pulse peak (the reason is given).
-* Wave speed (Fig. 16b): from the first arrivals at A–G (:mod:`postprocess.arrivals`:
+* Wave speed (Fig. 16b): from the first arrivals at A–G (:mod:`mpipd.post.arrivals`:
   10 % of the peak of each probe's first pulse, arrival times increasing with d, least-squares slope
   of d against t; Table 1's c_P = sqrt((K + 4G/3)/rho) = 4595 m/s), and beside it the
   paper's method, the arrival time of the peak (the largest sample refined by a

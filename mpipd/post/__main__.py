@@ -1,4 +1,4 @@
-"""``mpirun -n N python -m postprocess {summary | wave-speed | fracture | report | compare |
+"""``mpirun -n N python -m mpipd.post {summary | wave-speed | fracture | report | compare |
 validate} RUN.h5``
 
 summary      points, frames, time span, energy drift (or the ledger's largest |balance|),
@@ -9,12 +9,12 @@ wave-speed   arrival speed of a pulse: the peak time of the cross-section mean o
 fracture     a PNG of the damage phi (or another scalar field) on the z section
              nearest --z (default: mid-thickness) at a frame (default: the last)
 report       the paper's figures (Figs. 7, 9, 11-13, 15-18, 20) of one run and a
-             validation report: report.md and report.json in --out (postprocess.report)
+             validation report: report.md and report.json in --out (mpipd.post.report)
 compare      several runs side by side: compare.md/.json and the fracture patterns,
              rock energy and peak radial stress of all runs in one figure each
 validate     the validation record (issue 15): OUT.md with every run's provenance, one
              table of the targets (a value and verdict column per run), key figures and
-             report.json copied into OUT/<case>/ (postprocess.validation); a run file or
+             report.json copied into OUT/<case>/ (mpipd.post.validation); a run file or
              run folder is reported first
 
 A file that is not a readable mpipd run file gives one line on stderr and exit status 2.
@@ -173,7 +173,7 @@ def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[
 def main(argv=None) -> int:
     from mpi4py import MPI
     comm = MPI.COMM_WORLD
-    ap = argparse.ArgumentParser(prog="python -m postprocess", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m mpipd.post", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     s = sub.add_parser("summary")
     s.add_argument("run")
@@ -240,7 +240,7 @@ def main(argv=None) -> int:
         run = Run(args.run, comm)
     except RunFileError as e:
         if comm.Get_rank() == 0:
-            print(f"postprocess: error: {e}", file=sys.stderr)
+            print(f"mpipd.post: error: {e}", file=sys.stderr)
         return 2
     try:
         if args.cmd == "summary":
@@ -259,7 +259,7 @@ def main(argv=None) -> int:
             lines.append(f"wave speed {speed:.2f} m/s")
     except (KeyError, ValueError) as e:
         if comm.Get_rank() == 0:
-            print(f"postprocess: error: {e}", file=sys.stderr)
+            print(f"mpipd.post: error: {e}", file=sys.stderr)
         return 2
     finally:
         run.close()
@@ -313,7 +313,7 @@ def _guarded(comm, fn, *args) -> int:
         lines = fn(*args)
     except (RunFileError, UsageError) as e:
         if comm.Get_rank() == 0:
-            print(f"postprocess: error: {' '.join(str(e).split())}", file=sys.stderr)
+            print(f"mpipd.post: error: {' '.join(str(e).split())}", file=sys.stderr)
         return 2
     except Exception:                                     # noqa: BLE001
         import traceback

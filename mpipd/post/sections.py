@@ -9,7 +9,7 @@ its own dx and z levels: the section takes, in each zone, that zone's level
 nearest the reference zone's level (``model.rock``), so it spans the whole rock.
 Each point of a section carries its zone's ``h`` (dx) and ``link`` (horizon).
 
-A z level is never split between reading ranks (:mod:`postprocess.reader`), so its
+A z level is never split between reading ranks (:mod:`mpipd.post.reader`), so its
 owner reads it with one contiguous hyperslab per (field, frame) and sends it to
 rank 0: one section, never the model.
 

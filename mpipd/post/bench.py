@@ -1,8 +1,8 @@
-"""``python -m postprocess bench RUN.h5 [RUN.h5 ...]``: what a blasting engineer
+"""``python -m mpipd.post bench RUN.h5 [RUN.h5 ...]``: what a blasting engineer
 judges a bench blast by, for one or several runs side by side (the delay cases of
 ``blast_bench``).  For each run:
 
-* **fragmentation**: the fragments of the last frame (postprocess.fragment_report):
+* **fragmentation**: the fragments of the last frame (mpipd.post.fragment_report):
   X20, X50, X80 (sieve size), the Rosin–Rammler uniformity n and the Swebrec b,
   the fines and the largest fragment as mass fractions;
 * **overbreak**: how far damage reaches behind the row of holes, normal to the
@@ -201,7 +201,7 @@ def _table(rows, runs) -> str:
         body.append(f"| {name} | " + " | ".join("—" if v is None else fmt.format(v)
                                                   for v in vals) + " |")
     src = ", ".join(f"`{r}`" for r in runs)
-    return (f"Made by `python -m postprocess bench` from {src} (last frame, "
+    return (f"Made by `python -m mpipd.post bench` from {src} (last frame, "
             f"t = {rows[labels[0]]['t_end_us']:.3g} us; burden {rows[labels[0]]['burden_mm']:.3g} mm).\n\n"
             + head + "\n".join(body) + "\n")
 

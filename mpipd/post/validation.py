@@ -1,16 +1,16 @@
-"""``python -m postprocess validate --out studies/validation/record RUN [RUN ...] [--notes NOTES.md]``:
+"""``python -m mpipd.post validate --out studies/validation/record RUN [RUN ...] [--notes NOTES.md]``:
 a validation record that anyone can re-create from run files (issue 15).
 
 Each RUN is a report directory (``report.json`` and the figures of
-``python -m postprocess report``), a run folder holding ``run.h5``, or a run file;
+``python -m mpipd.post report``), a run folder holding ``run.h5``, or a run file;
 for a run folder or run file the report is made first, by
-:func:`postprocess.report.make_report` (all ranks), into ``report/`` beside the
+:func:`mpipd.post.report.make_report` (all ranks), into ``report/`` beside the
 run file.  Rank 0 then writes
 
 * ``<out>.md`` (``--out studies/validation/record`` writes ``studies/validation/record.md``): the
   command that made it; each run's provenance; the named cases of the rows' scenes
-  and the rows that ran each (:mod:`postprocess.case_coverage`); one table with a row per target of
-  :data:`postprocess.targets.TARGETS` — the paper's and the experiment's value and,
+  and the rows that ran each (:mod:`mpipd.post.case_coverage`); one table with a row per target of
+  :data:`mpipd.post.targets.TARGETS` — the paper's and the experiment's value and,
   per run, its value and verdict; a section per run with its key figures; the
   lattice-bias table of the reports that have one; the ``--notes`` text verbatim
   under "Diagnoses";
@@ -18,9 +18,9 @@ run file.  Rank 0 then writes
   the record is read from it) and its key figures, downscaled to at most 900 px wide.
 
 No number of the record is typed in: values come from each report.json's
-``targets`` rows (made by :func:`postprocess.analysis.targets_table`), and each
-verdict is :func:`postprocess.targets.verdict` of the stored value with the bounds
-:func:`postprocess.analysis.target_bounds` takes from the same report.json (a
+``targets`` rows (made by :func:`mpipd.post.analysis.targets_table`), and each
+verdict is :func:`mpipd.post.targets.verdict` of the stored value with the bounds
+:func:`mpipd.post.analysis.target_bounds` takes from the same report.json (a
 verdict that differs from the one stored in report.json is shown with both).
 
 Every input is checked before anything is written: a missing run file, or a
@@ -106,7 +106,7 @@ def resolve(args) -> list[Input]:
             inputs.append(Input(a, p, p.parent / "report"))
         elif p.is_dir():
             missing.append(f"{a} has neither report.json nor run.h5 (make the report with "
-                           f"`mpirun -n {RANKS_HINT} python -m postprocess report RUN.h5 --out "
+                           f"`mpirun -n {RANKS_HINT} python -m mpipd.post report RUN.h5 --out "
                            f"{a}`)")
         else:
             run_file = p if p.suffix == ".h5" else p / "run.h5"
@@ -124,7 +124,7 @@ def load_report(d: Path) -> dict:
         raise InputError(f"cannot read {d / 'report.json'}: {' '.join(str(e).split())}") from None
     for key in ("run", "targets", "figures"):
         if key not in doc:
-            raise InputError(f"{d / 'report.json'} has no {key!r}: not a postprocess report")
+            raise InputError(f"{d / 'report.json'} has no {key!r}: not a report of mpipd.post")
     for name, _ in KEY_FIGURES:
         f = doc["figures"].get(name)
         if f and not (d / f).is_file():
@@ -341,7 +341,7 @@ def targets_table(runs) -> list[str]:
     head = "| quantity | unit | paper | experiment | range used | " + " | ".join(
         f"{r['case']} | {r['case']} verdict" for r in runs) + " |"
     L = ["## Targets", "",
-         "One row per target of `postprocess/targets.py`.  Values are the `targets` rows of "
+         "One row per target of `mpipd/post/targets.py`.  Values are the `targets` rows of "
          "each run's report.json; verdicts are `targets.verdict` of those values (the "
          "consistency row against the bounds in the same report.json).  'information' rows "
          "are shown, not judged.", "",
@@ -423,7 +423,7 @@ def bias_table(runs) -> list[str]:
 
 def orientation_table(runs) -> list[str]:
     """Crack orientation per run and section (report.json ``fracture.sections.*.
-    orientation``, :mod:`postprocess.crack_orientation`): the share of each class in
+    orientation``, :mod:`mpipd.post.crack_orientation`): the share of each class in
     zones 2-3, the circumferential density per zone and the ring arcs."""
     def secs(r):
         fr = r["doc"].get("fracture", {})
@@ -434,7 +434,7 @@ def orientation_table(runs) -> list[str]:
         return []
     L = ["## Crack orientation", "",
          "From `fracture.sections.*.orientation` of each report.json "
-         "(postprocess/crack_orientation.py): the local direction of the failed points "
+         "(mpipd/post/crack_orientation.py): the local direction of the failed points "
          "within the horizon, classed radial (< 30° from e_r), oblique or circumferential "
          "(> 60°) where they form a line; junctions, the crushed zone and wide bands are "
          "unresolved.  Shares are of the failed crack length in zones 2 and 3; the ring "
@@ -512,7 +512,7 @@ def run_section(k, r) -> list[str]:
 
 def render(runs, command, code_commit, notes, base=None) -> str:
     L = ["# Validation record", "",
-         f"Made by `{command}` (postprocess at commit {code_commit}); `make validate` "
+         f"Made by `{command}` (mpipd/post at commit {code_commit}); `make validate` "
          "re-creates it from the run files in `VALIDATE_RUNS` (studies/validate.mk).  Every number "
          "below is read from the runs' report.json files, copied beside this file; none is "
          "typed in.", ""]
@@ -548,16 +548,16 @@ def shrink_png(src: Path, dst: Path, width: int = MAX_WIDTH) -> tuple[int, int]:
 
 
 def code_commit() -> str:
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]     # the repository
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
                               text=True, timeout=10, check=True).stdout.strip()
         dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--",
-                                "postprocess"], capture_output=True, text=True, timeout=10,
+                                "mpipd/post"], capture_output=True, text=True, timeout=10,
                                check=True).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown (not a git checkout)"
-    return head[:12] + (" with uncommitted changes in postprocess/" if dirty else "")
+    return head[:12] + (" with uncommitted changes in mpipd/post/" if dirty else "")
 
 
 def make_validation(args, out, comm, notes=None, argv=None, check_only=False,
@@ -606,7 +606,7 @@ def make_validation(args, out, comm, notes=None, argv=None, check_only=False,
         for f in r["figures"].values():
             shrink_png(r["input"].report_dir / f, d / Path(f).name)
         r["figures"] = {n: Path(f).name for n, f in r["figures"].items()}
-    command = "python -m postprocess " + shlex.join(argv if argv is not None else
+    command = "python -m mpipd.post " + shlex.join(argv if argv is not None else
                                                     ["validate", "--out", str(out), *args])
     md.write_text(render(runs, command, code_commit(), notes_text, base))
     stale = sorted(p.name for p in out.iterdir() if p.is_dir() and p.name not in taken)

@@ -1,7 +1,7 @@
-"""``python -m postprocess report RUN.h5 [--out DIR]``: the paper's figures of one
+"""``python -m mpipd.post report RUN.h5 [--out DIR]``: the paper's figures of one
 run and a validation report (``report.md``, the same numbers in ``report.json``).
 
-All ranks read and reduce (:mod:`postprocess.analysis`); rank 0 draws the figures
+All ranks read and reduce (:mod:`mpipd.post.analysis`); rank 0 draws the figures
 and writes the files.  The JSON holds only numbers derived from the run file, so
 it is identical whatever the number of reading ranks.
 """

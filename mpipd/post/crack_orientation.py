@@ -4,11 +4,11 @@ The paper reports cracks in both directions: "minor cracks are developed in both
 the radial and the circumferential directions" (§3.2, Figs. 9, 13), and for
 Table 3's case 5 "some small ring cracks (spalling)" (§3.5, Fig. 22e).  The crack
 density of Fig. 12 counts failed points whatever their direction, and the major
-radial cracks (:func:`postprocess.cracks.radial_cracks`) count only what reaches
+radial cracks (:func:`mpipd.post.cracks.radial_cracks`) count only what reaches
 the boundary from zone 1; this module measures the direction of the rest.
 
 Local direction.  A crack on a section is a chain of failed points
-(:func:`postprocess.cracks.failed_points`) one or two spacings wide.  For each
+(:func:`mpipd.post.cracks.failed_points`) one or two spacings wide.  For each
 failed point i, the failed points within the horizon delta_i (Euclidean, i
 included) are its neighbourhood; with C_i their covariance about their centroid,
 
@@ -29,7 +29,7 @@ between t_i and the radial direction e_r = (x_i - c)/|x_i - c|:
 so that failure whose direction is random gives each class a third of the
 classified points (psi uniform on [0, 90 deg]).
 
-Per crack-density zone (:func:`postprocess.cracks.zone_edges`), each class's
+Per crack-density zone (:func:`mpipd.post.cracks.zone_edges`), each class's
 count and its crack length (each point stands for its own dx, as in Fig. 12: a
 crack two points wide counts twice, as in the crack density), and the
 circumferential crack density: circumferential length / ring area (mm/mm^2, the
@@ -47,7 +47,7 @@ measure of how much ring cracking there is.
 
 Failed rings.  A ring crack wider than about three points (a spall band) is
 unresolved by the local direction, and is found by the failed fraction in rings
-of width dx from the wall (:func:`postprocess.cracks.ring_index`, as the crushed
+of width dx from the wall (:func:`mpipd.post.cracks.ring_index`, as the crushed
 zone's): beyond the crushed zone and the qualifying rings joined to it, each
 unbroken run of rings in which at least RING_FRACTION = 1/2 of the points have
 failed, and fewer than half of those are radial, is a failed ring: more than half

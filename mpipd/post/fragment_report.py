@@ -1,5 +1,5 @@
-"""``python -m postprocess fragments RUN.h5``: the fragments of a frame and the
-fragment-size distribution (postprocess.fragments, postprocess.sieve).
+"""``python -m mpipd.post fragments RUN.h5``: the fragments of a frame and the
+fragment-size distribution (mpipd.post.fragments, mpipd.post.sieve).
 
 Writes into ``--out`` (default ``<run dir>/fragments``):
 

@@ -1,7 +1,7 @@
 """The fragment-size distribution: the mass passing curve, its percentiles and fits.
 
 Passing curve.  With fragments sorted by size x_i (a sieve size, mpipd's
-postprocess.fragments), P(x_i) is the mass fraction of the fragments of size
+mpipd.post.fragments), P(x_i) is the mass fraction of the fragments of size
 <= x_i.  The percentile X_q (X20, X50, X80) is the size where P reaches q,
 interpolated linearly in ln x between the fragment below q and the one that
 reaches it (the size of the fragment itself when it alone carries P across q

@@ -26,7 +26,7 @@ import tomllib
 
 from mpipd.input import scene as sc
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]       # the repository
 #: where a built-in scene's file has lived (the latter before the input/ folder)
 SCENE_DIRS = ("mpipd/input/scenes", "mpipd/scenes")
 
@@ -159,7 +159,7 @@ def coverage_table(runs) -> list[str]:
          "since that commit.  A case counts when a row ran it at its own settings, on "
          "today's scene, to its t_end.  Only this record's rows count (`make cases` runs "
          "every case of blast_demo: studies/cases/blast_demo.md).  Read from report.json, the "
-         "scene files and git (postprocess/case_coverage.py).", ""]
+         "scene files and git (mpipd/post/case_coverage.py).", ""]
     for base in sorted(by_scene):
         known = sc.cases(base)
         L += [f"### {base}", "", "| case | study | what it changes | rows |", "|---|---|---|---|"]

@@ -1,8 +1,8 @@
-"""``python -m postprocess compare RUN.h5 RUN.h5 ... [--out DIR]``: several runs side
+"""``python -m mpipd.post compare RUN.h5 RUN.h5 ... [--out DIR]``: several runs side
 by side — the discretisation study (paper §3.4, Figs. 19–21) and the Table 3
 sensitivity cases (§3.5, Fig. 22).
 
-Each run is analysed exactly as by ``report`` (:func:`postprocess.analysis.analyse`,
+Each run is analysed exactly as by ``report`` (:func:`mpipd.post.analysis.analyse`,
 all ranks, one run after another); rank 0 then writes
 
 * ``compare.md`` / ``compare.json`` — the target measures of every run in one
@@ -64,7 +64,7 @@ def render(runs) -> str:
         f"{max(r['energy']['total_J'] or r['energy']['kinetic_J']):.4g}" for r in runs) + " |")
     L.append("| errors (impossible values) | | " + " | ".join(
         str(len(r["errors"])) for r in runs) + " |")
-    L += ["", "'in' / 'out': within / outside the range of `postprocess/targets.py` (see a "
+    L += ["", "'in' / 'out': within / outside the range of `mpipd/post/targets.py` (see a "
           "run's report for the ranges); 'error': an impossible value (see the run's report).",
           "",
           "![fracture](compare_fracture.png)", "", "![energy](compare_energy.png)", "",

@@ -11,7 +11,7 @@ rank reads one frame of one field of its own slice at a time).
   added in level order (bit-identical on any number of reading ranks).  A total below
   -1e-9 of its largest magnitude is an error, not a number.
 * Time histories at the saved frames (drawn in Fig. 7; never used as peaks, which
-  come from :mod:`postprocess.peaks`): the largest -sigma_rr and mean pressure of
+  come from :mod:`mpipd.post.peaks`): the largest -sigma_rr and mean pressure of
   the rock's wall layer (r < R_b + wall_dx) and the largest gas pressure, and the
   mean pressure of the charge points of each z level at a few frames (pressure
   along the borehole).  With the ``gas_force`` field both take only the gas points
@@ -33,7 +33,7 @@ rank reads one frame of one field of its own slice at a time).
   carry no force and coast; without it every point counts as acting.  Any acting
   point in intact rock makes the block an error naming the largest count and
   fraction of the charge; passive ones are counted beside it.
-* Gas containment by the tube, per frame (:mod:`postprocess.tube`): the gas points
+* Gas containment by the tube, per frame (:mod:`mpipd.post.tube`): the gas points
   outside the copper tube's current inner surface within its length, and those
   beyond its ends.  Absent (not available) without a tube holding a charge or
   without the ``u`` field.
