@@ -14,6 +14,9 @@ which array):
 ``cli``         ``mpipd run | check | scenes``
 ``post/``       reading run files after a run: ``python -m mpipd.post`` (report, figures)
 
+``mpipd.open(path)`` reads a run file from Python (mpipd.post.api), serially; it
+imports the reading code (h5py) when called, not when mpipd is imported.
+
 Importing mpipd never initialises MPI; the CLI and tests pass a communicator in.
 It does point numba's kernel cache at a directory keyed by the sources
 (mpipd.kernels.cache), and turns numba's colouring of error messages off: with it,
@@ -31,3 +34,13 @@ __version__ = "0.1.0"
 
 #: numba's cache directory, keyed by the sources (mpipd.kernels.cache)
 KERNEL_CACHE = _configure_kernel_cache()
+
+
+def open(path, comm=None):
+    """Open a run file (``run.h5`` or its folder) for reading from Python:
+    a :class:`mpipd.post.api.RunFile` with the frames, times, material and part names,
+    fields, sections, probes and energy ledger as NumPy arrays.  Serial without
+    ``comm`` (no MPI); with an mpi4py communicator every rank reads its own slice.
+    The reading code (h5py) is imported on the first call, not by ``import mpipd``."""
+    from .post.api import open as _open
+    return _open(path, comm)

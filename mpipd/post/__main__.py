@@ -28,6 +28,7 @@ import numpy as np
 
 from .fits import peak_time
 from .reader import Run, RunFileError
+from .sections import section
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -89,29 +90,6 @@ def wave_speed(run: Run, comm, axis: str, component: str, stations, tol) -> tupl
     return speed, arrivals
 
 
-def section(run: Run, comm, field: str, frame: int, z: float | None):
-    """x, y and field values of the points on the z level nearest ``z`` — gathered to
-    rank 0 (one section, not the model)."""
-    x = run.geometry("x")
-    zmin = run.min(x[:, 2].min() if len(x) else np.inf)
-    zmax = run.max(x[:, 2].max() if len(x) else -np.inf)
-    target = 0.5 * (zmin + zmax) if z is None else z
-    levels = np.unique(run.z_level)
-    near = levels[np.argmin(np.abs(levels - target))] if len(levels) else np.inf
-    dist = run.min(abs(near - target))
-    cands = comm.allgather(near if abs(near - target) == dist else np.inf)
-    zlev = min(cands)
-    sel = run.z_level == zlev
-    vals = run.field(field, frame)[sel]
-    if vals.ndim > 1:
-        raise ValueError(f"field {field!r} is not a scalar")
-    parts = comm.gather((x[sel, 0], x[sel, 1], vals), root=0)
-    if comm.Get_rank() != 0:
-        return None
-    xs, ys, vs = (np.concatenate([p[k] for p in parts]) for k in range(3))
-    return xs, ys, vs, zlev
-
-
 def frame_index(run: Run, frame: int) -> int:
     """``--frame`` as an index into the written frames (negative from the end);
     one outside them is refused."""
@@ -148,13 +126,15 @@ def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[
     k = frame_index(run, frame)
     check_z(run, comm, z)
     check_png_out(out)
-    sec = section(run, comm, field, k, z)
+    if run.has_field(field) and run.f["fields"][field].ndim > 2:
+        raise ValueError(f"field {field!r} is not a scalar")
+    sec = section(run, field, k, z)
     if comm.Get_rank() != 0:
         return []
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    xs, ys, vs, zlev = sec
+    xs, ys, vs, zlev = sec.x, sec.y, sec.values, sec.z
     fig, ax = plt.subplots(figsize=(6, 5.2), dpi=120)
     size = max(1.0, 2.2e4 / max(len(xs), 1))
     im = ax.scatter(xs * 1e3, ys * 1e3, c=vs, s=size, marker="s", cmap="inferno",

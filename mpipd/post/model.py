@@ -121,11 +121,6 @@ class Model:
                 "notes": self.notes}
 
 
-def _names(run, key) -> list[str]:
-    names = run.f["geometry"][key].attrs.get("names", [])
-    return [n.decode() if isinstance(n, bytes) else str(n) for n in names]
-
-
 def _parse_scene(run, notes):
     text = run.attr("scene")
     if not text:
@@ -164,8 +159,8 @@ def _pick(names, models, want_name, want_model):
 def load_model(run, label: str | None = None) -> Model:
     """Collective: every rank gets the same :class:`Model`."""
     notes: list[str] = []
-    parts = _names(run, "part")
-    mats = _names(run, "material")
+    parts = run.names("part")
+    mats = run.names("material")
     scene, sets = _parse_scene(run, notes)
     part_mat = {}
     models = [None] * len(parts)

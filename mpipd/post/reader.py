@@ -9,6 +9,10 @@ level and the per-level partial sums are added in global level order
 (:meth:`Run.level_total`).  So every number is bit-identical whatever the number
 of reading ranks.
 
+Without a communicator (``comm=None``) one process reads the whole file, with HDF5's
+default driver and no MPI at all (:class:`SerialComm` stands in for the communicator):
+the same code, one rank.
+
 A file that is not an mpipd run file (foreign or truncated HDF5, no frames)
 raises :class:`RunFileError` with a one-line message, on every rank alike.
 """
@@ -33,6 +37,47 @@ def shown_path(path) -> str:
         return str(p)
 
 
+class SerialComm:
+    """The communicator of a single process without MPI: the few mpi4py calls the
+    reader and the analyses make, each what it is on one rank (a reduction or a gather
+    of one value is that value).  Used when a run file is opened without ``comm``."""
+
+    def Get_rank(self) -> int:
+        return 0
+
+    def Get_size(self) -> int:
+        return 1
+
+    def allgather(self, x) -> list:
+        return [x]
+
+    def gather(self, x, root=0) -> list:
+        return [x]
+
+    def bcast(self, x, root=0):
+        return x
+
+    def allreduce(self, x, op=None):
+        return x
+
+    def Allreduce(self, sendbuf, recvbuf, op=None):
+        recvbuf[...] = sendbuf
+
+    def Barrier(self):
+        pass
+
+    def Abort(self, code=1):
+        raise SystemExit(code)
+
+
+class _SerialTeam(Team):
+    """:class:`~mpipd.parallel.team.Team` on a :class:`SerialComm`: its reductions need
+    no MPI operation (and so never import mpi4py)."""
+
+    def _op(self, name):
+        return name
+
+
 class RunFileError(Exception):
     """The file cannot be analysed (one line, names the file and the reason)."""
 
@@ -42,17 +87,24 @@ def _one_line(e) -> str:
 
 
 class Run:
-    """A run file opened by every rank of ``comm``; ``lo:hi`` is this rank's gid slice
-    (whole z levels); ``levels`` are the local offsets where a z level starts."""
+    """A run file opened by every rank of ``comm`` (or, with ``comm=None``, by this
+    process alone, without MPI); ``lo:hi`` is this rank's gid slice (whole z levels);
+    ``levels`` are the local offsets where a z level starts."""
 
-    def __init__(self, path, comm):
+    def __init__(self, path, comm=None):
         import h5py
-        self.comm = comm
-        self.team = Team(comm)
         self.path = str(path)
         self._geo = {}
+        if comm is None:
+            self.comm = SerialComm()
+            self.team = _SerialTeam(self.comm)
+            mode = {}
+        else:
+            self.comm = comm
+            self.team = Team(comm)
+            mode = {"driver": "mpio", "comm": comm}
         try:
-            self.f = h5py.File(path, "r", driver="mpio", comm=comm)
+            self.f = h5py.File(path, "r", **mode)
         except (OSError, ValueError) as e:
             raise RunFileError(f"cannot open {path}: {_one_line(e)}") from None
         try:
@@ -132,6 +184,12 @@ class Run:
             self._geo[name] = self.f["geometry"][name][self.lo:self.hi]
         return self._geo[name]
 
+    def names(self, key: str) -> list[str]:
+        """The names of the materials (``key="material"``) or parts (``"part"``), indexed
+        by the ids in ``/geometry/<key>`` (its ``names`` attribute)."""
+        names = self.f["geometry"][key].attrs.get("names", [])
+        return [n.decode() if isinstance(n, bytes) else str(n) for n in names]
+
     def has_field(self, name: str) -> bool:
         return "fields" in self.f and name in self.f["fields"]
 
@@ -147,12 +205,14 @@ class Run:
         if not self.has_field(name):
             raise KeyError(f"the run has no field {name!r} "
                            f"(it has: {', '.join(self.field_names) or 'none'})")
-        frame = self._written(frame)
+        frame = self.written(frame)
         a, b = (0, self.hi - self.lo) if span is None else span
         return self.f["fields"][name][frame, self.lo + a:self.lo + b]
 
-    def _written(self, frame):
-        """``frame`` (an index or a slice) within the written frames."""
+    def written(self, frame):
+        """``frame`` (an index or a slice) within the written frames: a slice cut to
+        them, an index as a non-negative one (negative counts from the last written);
+        an index outside them raises IndexError."""
         if isinstance(frame, slice):
             r = range(self.frames)[frame]
             return slice(r.start, r.stop if r.stop >= 0 else None, r.step)

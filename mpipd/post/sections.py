@@ -16,10 +16,18 @@ rank 0: one section, never the model.
 The axial plane (paper Figs. 7, 8) is the first lattice row above the axis,
 0 < y - y_c < dx_p of each part p: it runs through every rank's slab and is
 gathered row by row.
+
+:func:`section` is the section of any run (``python -m mpipd.post fracture`` and
+``mpipd.open(...).section``): the points of one z level nearest a height, of every
+part or of the parts one name selects.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from mpipd.input.probes import part_matches
 
 #: the named sections of a specimen of thickness T (z0 = the detonation end)
 NAMED = ("detonation end face", "z0 + 5 mm", "mid-thickness", "z1 - 5 mm", "far end face")
@@ -156,3 +164,72 @@ def section_images(sec, key, center, r_out) -> list:
         m = h == dx
         out.append(lattice_image(sec["x"][m], sec["y"][m], sec[key][m], center, float(dx), r_out))
     return out
+
+
+@dataclass(frozen=True)
+class Section:
+    """The points of one lattice level of z and a field's values on them, in gid order.
+
+    ``x``, ``y``: the points' reference positions (m); ``gid``: their global ids;
+    ``values``: the field at the frame, one row a point (``(n,)`` for a scalar field,
+    ``(n, k)`` for a vector or tensor); ``z``: the level's z (m); ``field``,
+    ``frame`` (the index of the written frame, from 0) and ``time`` (s) say what was
+    read; ``part``: the part name that selected the points (None: every part)."""
+    x: np.ndarray
+    y: np.ndarray
+    gid: np.ndarray
+    values: np.ndarray
+    z: float
+    field: str
+    frame: int
+    time: float
+    part: str | None
+
+
+def part_mask(run, part: str | None) -> np.ndarray:
+    """This rank's points that belong to ``part``: the part of that name and its zones
+    (``rock`` selects ``rock`` and ``rock.ring1``: :func:`mpipd.input.probes.part_matches`);
+    every point for None.  An unknown name is refused (ValueError naming the parts)."""
+    pid = run.geometry("part")
+    if part is None:
+        return np.ones(len(pid), bool)
+    names = run.names("part")
+    ok = np.array([part_matches(part, q) for q in names], bool)
+    if not ok.any():
+        raise ValueError(f"no part {part!r} in the run (its parts: {', '.join(names) or 'none'})")
+    return ok[pid] if len(pid) else np.zeros(0, bool)
+
+
+def section(run, field: str = "damage", frame: int = -1, z: float | None = None,
+            part: str | None = None) -> Section | None:
+    """The points of the z level nearest ``z`` (default: half-way between the lowest and
+    the highest point) and ``field`` at ``frame`` on them, gathered to rank 0 (one
+    section, never the model): a :class:`Section` on rank 0, None on the other ranks.
+
+    With ``part``, only that part's points (and its zones') count: the height
+    defaults to the middle of the part, the level is the nearest that holds some of
+    its points, and the section holds its points only.  Collective: every rank of the
+    run calls it.  A part with no points is refused (ValueError)."""
+    mine = part_mask(run, part)
+    x = run.geometry("x")
+    xs = x[mine]
+    if part is not None and not run.sum_int(int(mine.sum())):
+        raise ValueError(f"part {part!r} has no points")
+    zmin = run.min(xs[:, 2].min() if len(xs) else np.inf)
+    zmax = run.max(xs[:, 2].max() if len(xs) else -np.inf)
+    target = 0.5 * (zmin + zmax) if z is None else z
+    levels = np.unique(run.z_level[mine])
+    near = levels[np.argmin(np.abs(levels - target))] if len(levels) else np.inf
+    dist = run.min(abs(near - target))
+    cands = run.comm.allgather(near if abs(near - target) == dist else np.inf)
+    zlev = min(cands)
+    sel = (run.z_level == zlev) & mine
+    k = run.written(frame)
+    vals = run.field(field, k)[sel]
+    gid = run.lo + np.flatnonzero(sel)
+    parts = run.comm.gather((x[sel, 0], x[sel, 1], gid, vals), root=0)
+    if not run.root:
+        return None
+    cols = [np.concatenate([p[i] for p in parts]) for i in range(4)]
+    return Section(x=cols[0], y=cols[1], gid=cols[2], values=cols[3], z=float(zlev),
+                   field=field, frame=k, time=float(run.time[k]), part=part)
