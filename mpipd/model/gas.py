@@ -50,9 +50,9 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..kernels.energy import trapezoid_work
 from ..kernels.layout import GD_A, GD_P, GD_V, GD_WIDTH
 from ..kernels.search import MAX_CELLS, cell_counts, cell_pairs, max_moved2, merge_rows, near_cells
-from ..kernels.energy import trapezoid_work
 from ..kernels.ul import GasParams, gas_contact_energy, gas_gather, gas_update
 from ..kernels.wall import wall_gather, wall_update
 from ..parallel.near import NearHalo
