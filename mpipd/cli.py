@@ -1,11 +1,11 @@
-"""Command line: ``mpipd run | check | scenes``.
+"""Command line: ``mpipd run | check | scenes | cases`` (:data:`USAGE`).
 
     mpirun -n 2 mpipd run SCENE [--set key.path=value ...] [--out DIR] [--overwrite]
                               [--force] [--stop-after N]
     mpirun -n 3 mpipd run --restart DIR/checkpoint.h5 [--out DIR]
     mpipd check SCENE [--ranks N] [--set ...]
-    mpipd scenes
-    mpipd cases SCENE           (then run SCENE:CASE)
+    mpipd scenes [--show SCENE]     (--show: its TOML and where it lives)
+    mpipd cases SCENE               (then run SCENE:CASE)
 
 SCENE is a TOML file or the name of a built-in scene.  Bad input (scene
 errors, an existing output file, a decomposition that cannot work, a corrupted
@@ -49,8 +49,32 @@ class IOFailure(Fatal):
     exit_code = EXIT_IO
 
 
+#: ``mpipd --help``'s text (plain, not reStructuredText): every subcommand with its usage
+DESCRIPTION = "mpipd: an MPI-parallel peridynamics solver for rock blasting."
+USAGE = """\
+commands:
+  mpirun -n 2 mpipd run SCENE [--set KEY=VALUE ...] [--out DIR] [--overwrite]
+                                 run a scene on 2 ranks (without mpirun: 1 rank)
+  mpirun -n 3 mpipd run --restart DIR/checkpoint.h5
+                                 continue a run from its checkpoint, on any number of ranks
+  mpipd check SCENE [--ranks N]  validate a scene; sizes, memory per rank, the stable dt
+  mpipd scenes                   list the built-in scenes
+  mpipd scenes --show SCENE      print a built-in scene's TOML and where it lives
+                                 (copy one: mpipd scenes --show blast_demo > my_blast.toml)
+  mpipd cases SCENE              list a built-in scene's named cases (run SCENE:CASE)
+
+SCENE is a TOML file, the name of a built-in scene, or SCENE:CASE.  KEY is a dotted
+path into the scene, array entries by number: --set parts.1.dx=5e-4.
+`mpipd COMMAND --help` gives a command's options.  Exit status: 0 done, 2 bad input
+(one line 'mpipd: error: ...'), 3 the run blew up, 4 a run file could not be written.
+Under mpirun as root, Open MPI needs OMPI_ALLOW_RUN_AS_ROOT=1 and
+OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 (and OMPI_MCA_rmaps_base_oversubscribe=1 for more
+ranks than cores)."""
+
+
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="mpipd", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="mpipd", description=DESCRIPTION, epilog=USAGE,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run a scene (under mpirun for several ranks)")
     r.add_argument("scene", nargs="?", help="scene file or built-in name (not with --restart)")
@@ -72,7 +96,10 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("scene")
     c.add_argument("--ranks", type=int, default=1)
     c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    sub.add_parser("scenes", help="list the built-in scenes")
+    s = sub.add_parser("scenes", help="list the built-in scenes (--show SCENE: its TOML)")
+    s.add_argument("--show", metavar="SCENE",
+                   help="print a built-in scene's TOML and where it lives; SCENE:CASE adds "
+                        "the case's overrides")
     k = sub.add_parser("cases", help="list the named cases of a built-in scene (run SCENE:CASE)")
     k.add_argument("scene")
     return ap
@@ -81,7 +108,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.cmd == "scenes":
-        return cmd_scenes()
+        return _guard_serial(cmd_show, args) if args.show else cmd_scenes()
     if args.cmd == "cases":
         return _guard_serial(cmd_cases, args)
     if args.cmd == "check":
@@ -113,6 +140,35 @@ def cmd_scenes() -> int:
         except Exception as e:   # a broken built-in is still listed
             desc = f"(invalid: {e})"
         print(f"{name:24s} {desc}")
+    print(f"\n(files in {sc.scenes_dir()}; print one: mpipd scenes --show NAME; "
+          f"its cases: mpipd cases NAME)")
+    return 0
+
+
+def cmd_show(args) -> int:
+    """``mpipd scenes --show SCENE[:CASE]``: the built-in scene's TOML as it is in its
+    file, headed by comment lines that say where it lives (so the output, redirected to
+    a file, is the same scene); for SCENE:CASE the comments also give the case's file,
+    description and overrides as ``--set`` options, to run the copy as the case."""
+    from .input import scene as sc
+    name, _, case = args.show.partition(":")
+    builtins = sc.builtin_scenes()
+    if name not in builtins:
+        raise UsageError(f"no built-in scene {name!r} (built-in: {', '.join(sorted(builtins))})")
+    path = builtins[name]
+    head = [f"# built-in scene {name}: {path}"]
+    if case:
+        known = sc.cases(name)
+        if case not in known:
+            raise UsageError(f"no case {case!r} of {name!r} "
+                             f"(cases: {', '.join(known) if known else 'none'})")
+        c = known[case]
+        head += [f"# case {name}:{case} ({sc.cases_dir() / (name + '.toml')}): {c.description}",
+                 f"# the case is this scene with the overrides below "
+                 f"(mpipd run {name}:{case}, or mpipd run COPY.toml with them):"]
+        head += [f"#   --set {shlex.quote(o)}" for o in c.set]
+    print("\n".join(head))
+    print(path.read_text(encoding="utf-8-sig"), end="")
     return 0
 
 

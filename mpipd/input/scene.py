@@ -523,10 +523,20 @@ class Scene:
 
 # --------------------------------------------------------------------------- loading
 
+def scenes_dir() -> Path:
+    """The folder of the built-in scenes (``mpipd/input/scenes`` in the package)."""
+    return Path(str(resources.files("mpipd.input") / "scenes"))
+
+
+def cases_dir() -> Path:
+    """The folder of the built-in scenes' named cases, one ``<scene>.toml`` a scene."""
+    return scenes_dir() / "cases"
+
+
 def builtin_scenes() -> dict[str, Path]:
     """Built-in scene name -> file."""
-    root = resources.files("mpipd.input") / "scenes"
-    return {Path(p.name).stem: Path(str(p)) for p in root.iterdir() if p.name.endswith(".toml")}
+    root = scenes_dir()
+    return {p.stem: p for p in root.iterdir() if p.name.endswith(".toml")}
 
 
 def resolve(source: str) -> Path:
@@ -613,8 +623,8 @@ class Case:
 
 
 def cases(scene_name: str) -> dict[str, Case]:
-    """The named cases of a built-in scene (``mpipd/scenes/cases/<scene>.toml``)."""
-    f = resources.files("mpipd.input") / "scenes" / "cases" / f"{scene_name}.toml"
+    """The named cases of a built-in scene (``mpipd/input/scenes/cases/<scene>.toml``)."""
+    f = cases_dir() / f"{scene_name}.toml"
     if not f.is_file():
         return {}
     raw = tomllib.loads(f.read_text())
