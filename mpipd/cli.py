@@ -191,6 +191,13 @@ def cmd_check(args) -> int:
         raise UsageError(f"--ranks must be >= 1 (got {args.ranks})")
     scene, _ = sc.load(args.scene, args.set)
     print(check_report(scene, args.ranks))
+    from .check import critical_dt
+    dt_max = critical_dt(scene)
+    if scene.time.dt > dt_max:
+        print(f"mpipd: error: dt = {scene.time.dt:.4e} s is above the stable step "
+              f"{dt_max:.4e} s: the run will be unstable (mpipd run refuses it without "
+              "--force; lower time.dt)", file=sys.stderr)
+        return EXIT_BAD_INPUT
     return 0
 
 
@@ -597,6 +604,7 @@ def summary(run: RunIO, first: int, wall: float, checkpointer, end_error: str | 
             log(f"mpipd: probe {name}: peak radial stress {srr / 1e6:.1f} MPa, peak |v_r| "
                 f"{vr:.2f} m/s, peak pressure {pmax / 1e6:.1f} MPa")
     log(f"mpipd: wrote {h5} and {h5.with_suffix('.xdmf')}")
+    _warnings(log, team, h5, sim)
     if end_error:
         kept = (f"{checkpointer.path.name} is still step {checkpointer.written_step}'s"
                 if checkpointer.written_step is not None
@@ -606,6 +614,28 @@ def summary(run: RunIO, first: int, wall: float, checkpointer, end_error: str | 
             f"the run file {h5} is complete to step {n_steps}", error=True)
         return EXIT_IO
     return 0
+
+
+def _warnings(log, team, h5, sim):
+    """The block of warnings a user cannot miss (mpipd.post.alerts), read back from the
+    finished run file (collective); a failure to read it is one line, never the run's."""
+    try:
+        from .post import alerts
+        from .post.model import load_model
+        from .post.reader import Run
+        end = None
+        if sim.gas is not None:
+            end = (team.sum(int(sim.gas.n_singular)), team.sum(len(sim.gas.gas_idx)))
+        run = Run(h5, team.comm)
+        try:
+            found = alerts.collect(run, load_model(run), end_no_force=end)
+        finally:
+            run.close()
+    except Exception as e:                                  # noqa: BLE001
+        log(f"mpipd: warning: the run's warnings could not be checked ({e})", error=True)
+        return
+    for line in alerts.lines(found):
+        log(f"mpipd: {line}", error=True)
 
 
 def _gas_summary(log, team, gas):

@@ -6,13 +6,20 @@ summary      points, frames, time span, energy drift (or the ledger's largest |b
 wave-speed   arrival speed of a pulse: the peak time of the cross-section mean of
              one velocity component at several stations along an axis, fitted by a
              straight line (parabolic interpolation of each peak between frames)
-fracture     a PNG of the damage phi (or another scalar field) on the z section
-             nearest --z (default: mid-thickness) at a frame (default: the last)
-report       the paper's figures (Figs. 7, 9, 11-13, 15-18, 20) of one run and a
-             validation report: report.md and report.json in --out (mpipd.post.report)
+fracture     a PNG of the damage phi (or another scalar field) on a z section of a
+             part that can fail (--part, default the rock) nearest --z (default:
+             the part's middle) at a frame (default: the last); says which part
+             and level, refuses a section that holds none of the part
+report       report.md, report.json and figures of one run in --out (mpipd.post.report):
+             for any scene, damage on named sections through the rock, failure
+             modes, per charge the damaged extent and crushed zone, the energy
+             ledger, the probes and the warnings; the paper's validation (figures,
+             targets) when the scene is the paper's specimen, or with --paper
+animate      a GIF of damage on a section through a part that can fail over the
+             saved frames (matplotlib's PillowWriter)
 compare      several runs side by side: compare.md/.json and the fracture patterns,
              rock energy and peak radial stress of all runs in one figure each
-validate     the validation record (issue 15): OUT.md with every run's provenance, one
+validate     the validation record: OUT.md with every run's provenance, one
              table of the targets (a value and verdict column per run), key figures and
              report.json copied into OUT/<case>/ (mpipd.post.validation); a run file or
              run folder is reported first
@@ -28,7 +35,7 @@ import numpy as np
 
 from .fits import peak_time
 from .reader import Run, RunFileError
-from .sections import section
+from .sections import part_mask, section
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -122,32 +129,101 @@ def check_png_out(out: str) -> None:
         raise ValueError(f"--out {out}: no directory {p.resolve().parent}")
 
 
-def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None) -> list[str]:
+def failing_part(run) -> str:
+    """The part a damage picture shows by default: the rock (the part named ``rock``,
+    else of a ``jh2`` material, else the largest: :func:`mpipd.post.model.load_model`),
+    by its name without a zone suffix."""
+    from .model import base_name, load_model
+    m = load_model(run)
+    return base_name(m.part_names[m.rock])
+
+
+def fracture_png(run: Run, comm, out, field="damage", frame=-1, z=None, part=None) -> list[str]:
     k = frame_index(run, frame)
     check_z(run, comm, z)
     check_png_out(out)
     if run.has_field(field) and run.f["fields"][field].ndim > 2:
         raise ValueError(f"field {field!r} is not a scalar")
-    sec = section(run, field, k, z)
+    sec, part = part_section(run, field, k, z, part)
     if comm.Get_rank() != 0:
         return []
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    xs, ys, vs, zlev = sec.x, sec.y, sec.values, sec.z
     fig, ax = plt.subplots(figsize=(6, 5.2), dpi=120)
+    draw_section(ax, fig, sec, field, run.time[k], part)
+    fig.tight_layout()
+    fig.savefig(out)
+    plt.close(fig)
+    return [f"wrote {out}: {field} of part {part!r} on its z level {sec.z * 1e3:.4g} mm "
+            f"({len(sec.x)} points on the section)"]
+
+
+def part_section(run, field, k, z, part):
+    """The section of ``part`` (default :func:`failing_part`): its level nearest ``z``
+    (default its middle).  With ``z``, the level is the nearest of the whole model's; one
+    that holds none of the part's points is refused (ValueError naming the part's
+    nearest level)."""
+    part = part or failing_part(run)
+    mine = part_mask(run, part)
+    if z is not None:
+        allz = run.comm.allgather(np.unique(run.z_level))
+        levels = np.unique(np.concatenate(allz)) if allz else np.zeros(0)
+        zlev = float(levels[np.argmin(np.abs(levels - z))])
+        own = run.comm.allgather(np.unique(run.z_level[mine]))
+        plev = np.unique(np.concatenate(own))
+        if not np.any(plev == zlev):
+            near = float(plev[np.argmin(np.abs(plev - z))])
+            raise ValueError(f"the section at z = {zlev * 1e3:.4g} mm (the level nearest --z "
+                             f"{z:g}) holds no point of part {part!r}: its nearest level is "
+                             f"z = {near:g} m (give --z {near:g}, or --part)")
+        z = zlev
+    return section(run, field, k, z, part=part), part
+
+
+def draw_section(ax, fig, sec, field, t, part):
+    xs, ys, vs = sec.x, sec.y, sec.values
     size = max(1.0, 2.2e4 / max(len(xs), 1))
     im = ax.scatter(xs * 1e3, ys * 1e3, c=vs, s=size, marker="s", cmap="inferno",
                     vmin=0.0, vmax=max(1.0, float(vs.max())) if field == "damage" else None)
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
-    ax.set_title(f"{field} at t = {run.time[k] * 1e6:.2f} us, z = {zlev * 1e3:.2f} mm")
-    fig.colorbar(im, ax=ax, shrink=0.85)
-    fig.tight_layout()
-    fig.savefig(out)
+    ax.set_title(f"{field} of {part} at t = {t * 1e6:.2f} us, z = {sec.z * 1e3:.2f} mm")
+    if fig is not None:
+        fig.colorbar(im, ax=ax, shrink=0.85)
+    return im
+
+
+def animate(run: Run, comm, out, field="damage", z=None, part=None, fps=4) -> list[str]:
+    """A GIF of ``field`` on one section of a part that can fail at every saved frame."""
+    from pathlib import Path
+    check_z(run, comm, z)
+    if Path(out).suffix.lower() != ".gif":
+        raise ValueError(f"--out {out}: the animation is a GIF (give a .gif path)")
+    check_png_out(out)
+    secs_ = []
+    for k in range(run.frames):
+        sec, part = part_section(run, field, k, z, part)
+        secs_.append(sec)
+        z = run.comm.bcast(sec.z if sec is not None else None, root=0)
+    if comm.Get_rank() != 0:
+        return []
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import PillowWriter
+    fig, ax = plt.subplots(figsize=(6, 5.2), dpi=100)
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, out, dpi=100):
+        for k, sec in enumerate(secs_):
+            ax.clear()
+            draw_section(ax, fig if k == 0 else None, sec, field, run.time[k], part)
+            fig.tight_layout()
+            writer.grab_frame()
     plt.close(fig)
-    return [f"wrote {out} ({len(xs)} points on the section)"]
+    return [f"wrote {out}: {field} of part {part!r} on its z level {secs_[0].z * 1e3:.4g} mm, "
+            f"{len(secs_)} frames"]
 
 
 def main(argv=None) -> int:
@@ -169,10 +245,28 @@ def main(argv=None) -> int:
     fr.add_argument("--out", default=None, help="PNG path (default: beside the run file)")
     fr.add_argument("--field", default="damage")
     fr.add_argument("--frame", type=int, default=-1)
-    fr.add_argument("--z", type=float, default=None, help="section height (m)")
+    fr.add_argument("--z", type=float, default=None,
+                    help="section height (m): the nearest z level of the model, which must "
+                         "hold points of the part (default: the part's middle level)")
+    fr.add_argument("--part", default=None,
+                    help="the part shown (default: the rock, the part that can fail)")
+    an = sub.add_parser("animate", help="a GIF of damage over the saved frames")
+    an.add_argument("run")
+    an.add_argument("--out", default=None, help="GIF path (default: beside the run file)")
+    an.add_argument("--field", default="damage")
+    an.add_argument("--z", type=float, default=None, help="section height (m), as fracture's")
+    an.add_argument("--part", default=None, help="the part shown (default: the rock)")
+    an.add_argument("--fps", type=float, default=4.0, help="frames per second (default 4)")
     rp = sub.add_parser("report", help="figures and report.md/report.json of one run")
     rp.add_argument("run")
     rp.add_argument("--out", default=None, help="directory (default: RUN's folder /report)")
+    pp = rp.add_mutually_exclusive_group()
+    pp.add_argument("--paper", dest="paper", action="store_true", default=None,
+                    help="the paper's validation report whatever the scene")
+    pp.add_argument("--no-paper", dest="paper", action="store_false",
+                    help="the report of any scene, even on the paper's specimen")
+    rp.add_argument("--fragments", action="store_true",
+                    help="also the fragments of the last frame (OUT/fragments)")
     rp.add_argument("--times", default=None,
                     help="comma-separated times (us) for the fracture pattern (default: four "
                          "saved frames evenly spaced, ending at the last)")
@@ -228,7 +322,11 @@ def main(argv=None) -> int:
         elif args.cmd == "fracture":
             from pathlib import Path
             out = args.out or str(Path(args.run).with_name(f"{args.field}.png"))
-            lines = fracture_png(run, comm, out, args.field, args.frame, args.z)
+            lines = fracture_png(run, comm, out, args.field, args.frame, args.z, args.part)
+        elif args.cmd == "animate":
+            from pathlib import Path
+            out = args.out or str(Path(args.run).with_name(f"{args.field}.gif"))
+            lines = animate(run, comm, out, args.field, args.z, args.part, args.fps)
         else:
             stations = [float(v) for v in args.stations.split(",")]
             tol = args.tol
@@ -271,7 +369,7 @@ def _analysis_cmd(args, comm) -> list[str]:
         if Path(out).exists() and not Path(out).is_dir():
             raise UsageError(f"--out {out} exists and is not a directory")
         times = [float(t) for t in args.times.split(",")] if args.times else None
-        return make_report(args.run, out, comm, times)
+        return make_report(args.run, out, comm, times, args.paper, args.fragments)
     if args.cmd == "validate":
         from .validation import InputError, make_validation
         try:

@@ -1,6 +1,8 @@
 """The run's energy ledger, ``/energy/<term>`` (J, one value per frame).
 
-Terms: mpipd.model.ledger's HELD and DISSIPATED (defined there, with what each means);
+Terms: mpipd.model.ledger's HELD and DISSIPATED (defined there, with what each means),
+the books (initial, external, boundary: the driven points' share) and any other
+dataset of /energy;
 the books close as initial + external = held + dissipated, and ``balance`` is the
 relative closure error (initial + external - held - dissipated) / scale.
 
@@ -20,14 +22,24 @@ import numpy as np
 from mpipd.model.ledger import BALANCE_TOL as TOL
 from mpipd.model.ledger import DISSIPATED, HELD, NON_NEGATIVE
 
-BOOKS = ("initial", "external")
+BOOKS = ("initial", "external", "boundary")
 TERMS = HELD + DISSIPATED + BOOKS
 OLD = ("strain", "total")          # the layout before the ledger
+SKIP = ("t", "balance")            # not terms: the time and the closure error
+
+
+def names_in(run) -> list[str]:
+    """Every term of the file's /energy: TERMS and OLD in that order, then any other
+    dataset (a term newer than this module) by name."""
+    known = [k for k in (*TERMS, *OLD) if run.has_energy(k)]
+    grp = run.f.get("energy")
+    extra = sorted(k for k in (grp or {}) if k not in known and k not in SKIP) if grp else []
+    return known + extra
 
 
 def read(run) -> dict:
     """Collective (every rank reads the small /energy datasets): the ledger block."""
-    names = [k for k in (*TERMS, *OLD) if run.has_energy(k)]
+    names = names_in(run)
     if not names and not run.has_energy("balance"):
         return {"not_available": "the run file has no /energy group"}
     series = {k: np.asarray(run.energy(k), float) for k in names}

@@ -33,6 +33,15 @@ rock and not of a ``jwl`` material, around a ``jwl`` part that is a cylinder on 
 same axis (within the tube's dx) no wider than the tube's inner radius + its dx.
 Each is ``{"part", "name", "center", "r_in", "r_out", "z", "dx", "charges"}``
 (``charges``: the part indices of the charges it holds).  No scene, no tube.
+
+``charges`` are every charge of the scene, one a part of a ``jwl`` material:
+``{"part", "name", "material", "center", "radius", "z", "dx", "p_CJ", "tube"}``
+(``radius``: the cylinder's, the hole it fills; ``p_CJ``: the Chapman-Jouguet pressure
+of its JWL constants times its ``pressure_factor``, Pa; ``tube``: the name of the tube
+holding it, or None).  Without a parsed scene there is no charge geometry: no charge.
+
+:func:`paper_geometry` says whether the scene is the paper's specimen (Fig. 6): a
+cylinder of rock (an annulus, every zone) with one charge on its axis, held by a tube.
 """
 from __future__ import annotations
 
@@ -80,6 +89,11 @@ class Model:
     explosive_materials: tuple = ()              # names of the jwl materials (the gas)
     probe_parts: dict = field(default_factory=dict)     # probe name -> its scene ``part``
     tubes: list = field(default_factory=list)    # the tubes holding a charge (docstring)
+    charges: list = field(default_factory=list)  # every charge (module docstring)
+    rock_is_annulus: bool = False                # every zone of the rock is an annulus
+    rock_material: str | None = None             # the rock's material name (scene)
+    rock_base: str = "rock"                      # the rock's part name without its zone
+    scene_parts: list = field(default_factory=list)     # the scene's part names, in order
     overrides: list = field(default_factory=list)
     notes: list = field(default_factory=list)
 
@@ -247,6 +261,9 @@ def load_model(run, label: str | None = None) -> Model:
             explosive = scene.materials[part_mat[charge]]
             pf = getattr(explosive, "pressure_factor", None)
     tubes = _tubes(parts, sparts, models, rock_ids)
+    charges = _charges(parts, sparts, models, scene, tubes) if scene is not None else []
+    annulus = bool(shape is not None and zones
+                   and all(hasattr(z.shape, "inner_radius") for z in zones))
     name = str(run.attr("scene_name", scene.name if scene is not None else "unknown"))
     return Model(label=label or name, scene_name=name, center=center, r_wall=r_wall,
                  r_out=r_out, z0=z0, z1=z1, dx=float(dx), rock=rock, charge=charge,
@@ -255,7 +272,49 @@ def load_model(run, label: str | None = None) -> Model:
                  rock_ids=rock_ids, zone_dx=zone_dx, zone_horizon=zone_horizon,
                  wall_dx=float(wall_dx), explosive=explosive,
                  peak_center=peak_center, part_material=part_mat, probe_parts=probe_parts,
-                 explosive_materials=explosives, tubes=tubes)
+                 explosive_materials=explosives, tubes=tubes, charges=charges,
+                 rock_is_annulus=annulus, rock_material=part_mat.get(rock),
+                 rock_base=rock_base,
+                 scene_parts=[p.name for p in scene.parts] if scene is not None else [])
+
+
+def paper_geometry(model) -> tuple[bool, str]:
+    """Is the scene the paper's specimen (Fig. 6)?  A cylinder of rock (every zone an
+    annulus), exactly one charge, on the rock's axis (within the rock's dx), held by a
+    tube.  Returns the answer and why (the first condition that fails, or the match)."""
+    if not model.rock_is_annulus:
+        return False, "the rock is not a cylinder around a borehole (an annulus)"
+    if len(model.charges) != 1:
+        return False, f"the scene has {len(model.charges)} charges, not one"
+    c = model.charges[0]
+    off = float(np.hypot(c["center"][0] - model.center[0], c["center"][1] - model.center[1]))
+    if off > model.dx:
+        return False, f"the charge is {off * 1e3:.3g} mm off the rock's axis"
+    if c["tube"] is None:
+        return False, "no tube holds the charge"
+    return True, (f"a cylinder of rock ({model.part_names[model.rock]!r}) with one charge "
+                  f"({c['name']!r}) on its axis in a tube ({c['tube']!r})")
+
+
+def _charges(parts, sparts, models, scene, tubes) -> list[dict]:
+    """Every charge of the parsed scene (module docstring)."""
+    out = []
+    held = {c: t["name"] for t in tubes for c in t["charges"]}
+    for k, n in enumerate(parts):
+        sp = sparts.get(n)
+        if sp is None or models[k] != "jwl":
+            continue
+        sh, mat = sp.shape, scene.materials[sp.material]
+        center = (tuple(float(v) for v in sh.center[:2]) if hasattr(sh, "center") else None)
+        radius = float(sh.radius) if hasattr(sh, "radius") else None
+        z = (float(sh.z[0]), float(sh.z[1])) if hasattr(sh, "z") else None
+        p_cj = None
+        if hasattr(mat, "chapman_jouguet"):
+            p_cj = float(mat.chapman_jouguet()["p"]) * float(getattr(mat, "pressure_factor", 1.0))
+        out.append({"part": k, "name": n, "material": sp.material, "center": center,
+                    "radius": radius, "z": z, "dx": float(sp.dx), "p_CJ": p_cj,
+                    "tube": held.get(k)})
+    return out
 
 
 def _tubes(parts, sparts, models, rock_ids) -> list[dict]:

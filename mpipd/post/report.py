@@ -1,5 +1,12 @@
-"""``python -m mpipd.post report RUN.h5 [--out DIR]``: the paper's figures of one
-run and a validation report (``report.md``, the same numbers in ``report.json``).
+"""``python -m mpipd.post report RUN.h5 [--out DIR] [--paper | --no-paper]
+[--fragments]``: the report of one run (``report.md``, the same numbers in
+``report.json``, and figures).
+
+Which report: the paper's validation report (its figures, targets, experiment bars,
+zones and Fig. 11 sections) when the scene is the paper's specimen
+(:func:`mpipd.post.model.paper_geometry`: a cylinder of rock with one charge on its
+axis in a tube) or with ``--paper``; else the report of any scene
+(:mod:`mpipd.post.scene_report`).  Both carry the warnings of :mod:`mpipd.post.alerts`.
 
 All ranks read and reduce (:mod:`mpipd.post.analysis`); rank 0 draws the figures
 and writes the files.  The JSON holds only numbers derived from the run file, so
@@ -76,13 +83,28 @@ def _figures(metrics, data, model, times, label, out: Path) -> tuple[dict, dict]
     return made, skipped
 
 
-def make_report(path, out, comm, pattern_us=None) -> list[str]:
+def make_report(path, out, comm, pattern_us=None, paper=None, fragments=False) -> list[str]:
+    """``paper``: None decides from the scene, True/False forces the paper's report or
+    the report of any scene."""
+    from . import alerts
+    from .model import paper_geometry
     run = Run(path, comm)
     try:
         model = load_model(run)
         label = run_label(path, model)
         model.label = label
-        metrics, data = analyse(run, model, pattern_us)
+        is_paper, reason = paper_geometry(model)
+        use_paper = is_paper if paper is None else bool(paper)
+        if use_paper:
+            metrics, data = analyse(run, model, pattern_us)
+            lat = {n: {"around the borehole": v} for n, v in metrics["lattice_bias"].items()
+                   if n != "ring"} if "not_available" not in metrics["lattice_bias"] else {}
+            warnings = alerts.collect(run, model, lattice_measures=lat,
+                                      tube_result=metrics.get("tube_containment"))
+        else:
+            from . import scene_report
+            metrics, data = scene_report.analyse(run, model, pattern_us)
+            warnings = metrics.pop("warnings")
         times = run.time
         info = {"run_file": shown_path(path), "label": label,
                 "n_points": run.n_points, "run_ranks": _int(run.attr("ranks")),
@@ -95,18 +117,56 @@ def make_report(path, out, comm, pattern_us=None) -> list[str]:
                     segments=json.loads(run.attr("segments", "[]")))
     finally:
         run.close()
+    frag = _fragments(path, out, comm) if fragments else None
     if comm.Get_rank() != 0:
         return []
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    if not use_paper:
+        from . import scene_report
+        made, skipped = scene_report.figures(metrics, data, model, times, label, out)
+        doc = {"run": info, "paper": {"applied": False, "scene_is_paper": is_paper,
+                                      "reason": ("the paper's validation is not applied: "
+                                                 + reason) if not is_paper else
+                                      "the paper's validation is not applied (--no-paper)"},
+               "warnings": warnings, "figures": made, "figures_not_made": skipped,
+               **metrics, "fragments": frag}
+        scene_report.write(doc, out)
+        return _done(out, made, skipped, warnings)
     made, skipped = _figures(metrics, data, model, times, label, out)
     doc = {"run": info, "errors": metrics["errors"], "figures": made,
            "figures_not_made": skipped, **metrics}
-    (out / "report.json").write_text(json.dumps(doc, indent=1, default=_json) + "\n")
     from .report_md import render
-    (out / "report.md").write_text(render(doc))
-    return [f"wrote {out / 'report.md'}, {out / 'report.json'} and {len(made)} figures"
-            + (f" ({len(skipped)} not made: {', '.join(skipped)})" if skipped else "")]
+    doc["warnings"] = warnings
+    doc["paper"] = {"applied": True, "scene_is_paper": is_paper,
+                    "reason": reason if is_paper else f"--paper (the scene is not: {reason})"}
+    if frag:
+        doc["fragments"] = frag
+    (out / "report.json").write_text(json.dumps(doc, indent=1, default=_json) + "\n")
+    md = render(doc)
+    from .alerts import lines as warn_lines
+    block = warn_lines(warnings)
+    if frag:
+        md += "\n## Fragments\n\n" + frag + "\n"
+    md = md.replace("\n## Errors\n", "\n## Warnings\n\n" + ("\n".join(
+        f"- **{w['message']}.**  *Fix*: {w['fix']}." for w in warnings)
+        if block else "None.") + "\n\n## Errors\n", 1)
+    (out / "report.md").write_text(md)
+    return _done(out, made, skipped, warnings)
+
+
+def _done(out, made, skipped, warnings) -> list[str]:
+    from .alerts import lines as warn_lines
+    return ([f"wrote {out / 'report.md'}, {out / 'report.json'} and {len(made)} figures"
+             + (f" ({len(skipped)} not made: {', '.join(skipped)})" if skipped else "")]
+            + warn_lines(warnings))
+
+
+def _fragments(path, out, comm) -> str:
+    """The fragments of the last frame into OUT/fragments (rank 0 sees the lines)."""
+    from .fragment_report import make_fragments
+    lines = make_fragments(path, str(Path(out) / "fragments"), comm)
+    return ("`fragments/`: " + " ".join(lines)) if lines else "`fragments/`"
 
 
 def _int(v):

@@ -72,7 +72,7 @@ def render(doc) -> str:
         L.append("Overrides: " + ", ".join(f"`{o}`" for o in m["overrides"]) + ".")
     L += [f"Note: {n}" for n in m["notes"]]
     L += _errors(doc.get("errors", []))
-    L += ["", "## Targets (paper §3.2–3.5, DESIGN §8)", "",
+    L += ["", "## Targets (paper §3.2–3.5)", "",
           "The verdict compares the run's value with the range in the 'range used' column; "
           "the ranges are fixed constants (`mpipd/post/targets.py`), not tuned to runs.  The "
           "explosive's row is a physical consistency check against its own JWL constants "
@@ -269,7 +269,7 @@ def _ring_history(h) -> list[str]:
 
 
 def _lattice_bias(lb) -> list[str]:
-    L = ["## Lattice bias (issue 15)", ""]
+    L = ["## Lattice bias", ""]
     if _na(lb):
         return L + [f"Not available: {lb['not_available']}.", ""]
     L += [f"Ring: {lb['ring']}.  a_m = |c_m|/c_0, the m-fold Fourier amplitude of the failed "

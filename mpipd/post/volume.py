@@ -145,7 +145,8 @@ def scan(run, model, profile_frames) -> dict:
                                         "p_MPa": (a[ok, 0] / a[ok, 1] / 1e6).tolist()})
     out["failure_modes"] = _failure_modes(run, rock)
     out["gas_containment"] = (_containment(in_rock, in_intact, run.sum_int(int(gas.sum())),
-                                           run.time, passive if has_force else None)
+                                           run.time, passive if has_force else None,
+                                           tube=bool(model.tubes))
                               if has_u else {"not_available": "no u field or no explosive"})
     out["tube_containment"] = (held.result() if held is not None else {"not_available": (
         "no tube holding a charge in the scene" if not model.tubes else "no u field")})
@@ -184,7 +185,7 @@ def _gas_in_rock(run, model, x, u, ig, rock, h_rock, k, has_force) -> tuple[int,
 
 
 def _containment(in_rock: np.ndarray, in_intact: np.ndarray, n_gas: int, times,
-                 passive: np.ndarray | None = None) -> dict:
+                 passive: np.ndarray | None = None, tube: bool = True) -> dict:
     """Per frame, the explosive's points inside the rock and inside intact rock (those
     acting on it; ``passive``: those carrying no force, when the run says which)."""
     k = int(np.argmax(in_intact))
@@ -198,7 +199,8 @@ def _containment(in_rock: np.ndarray, in_intact: np.ndarray, n_gas: int, times,
         out["error"] = (f"{int(in_intact[k])} explosive points "
                         f"({100 * out['max_fraction_in_intact_rock']:.3g} % of the charge) "
                         f"inside intact rock at {out['max_at_us']:.3g} us: the gas passed "
-                        "through the tube and the borehole wall")
+                        + ("through the tube and the borehole wall" if tube else
+                           "through the borehole wall"))
     return out
 
 
