@@ -397,7 +397,7 @@ def check_report(scene, ranks: int) -> str:
                        for m, mat in scene.materials.items()
                        if m not in scene.gas_materials
                        and any(q.material == m for q in scene.parts))
-        out.append(f"  boundaries[{i}]: absorbing layer lining {bc.face} = {bc.at:g} m, "
+        out.append(f"  boundaries.{i}: absorbing layer lining {bc.face} = {bc.at:g} m, "
                    f"{bc.thickness * 1e3:g} mm thick, design reflection {bc.reflection:g}: "
                    f"damping at the face {cs}")
     out.append("  per material (bonds counted from the lattice cross-sections, the model is "

@@ -47,14 +47,14 @@ def test_box_holes_are_empty_and_the_tubes_fit_them():
 def test_bad_initiation_and_holes(tmp_path):
     out = tmp_path / "out"
     check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
-                       "parts.6.initiation={time=1e-6}"]), out, "parts[6].initiation",
+                       "parts.6.initiation={time=1e-6}"]), out, "parts.6.initiation",
               "only a charge")
     check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
-                       "parts.0.initiation.time=-1e-6"]), out, "parts[0].initiation.time",
+                       "parts.0.initiation.time=-1e-6"]), out, "parts.0.initiation.time",
               "must be >= 0")
     check_bad(run_cli(["run", "blast_bench", "--out", str(out), "--set",
                        "parts.6.shape.holes.0.center=[0.039, 0.015]"]), out,
-              "parts[6].shape.holes[0]", "inside the box")
+              "parts.6.shape.holes.0", "inside the box")
 
 
 @pytest.fixture(scope="module")

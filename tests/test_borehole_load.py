@@ -67,7 +67,7 @@ def test_wall_pressure_wave_and_energy_balance(team):
 def test_bad_load_in_a_scene_is_a_clear_error(tmp_path):
     res = run_cli(["check", "granite_ring", "--set",
                    'loads=[{kind="borehole_pressure", center=[0,0], radius=0.0032, p0=1e9}]'])
-    assert res.returncode == 2 and "loads[0]" in res.stderr and "either" in res.stderr
+    assert res.returncode == 2 and "loads.0" in res.stderr and "either" in res.stderr
 
 
 def test_radial_velocity_equals_the_impulse_matched_pressure(team):

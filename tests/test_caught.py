@@ -79,17 +79,17 @@ def test_an_initial_speed_no_material_has_is_bad_input(tmp_path, setting):
     before = md5s(out)
     res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--overwrite",
                    "--set", setting])
-    one_error(res, "initial[0].velocity", "speed of light")
+    one_error(res, "initial.0.velocity", "speed of light")
     assert md5s(out) == before
     res = run_cli(["check", "elastic_wave", "--set", setting])
-    one_error(res, "initial[0].velocity", "speed of light")
+    one_error(res, "initial.0.velocity", "speed of light")
 
 
 def test_a_radial_speed_of_1e200_is_bad_input(tmp_path):
     out = tmp_path / "r"
     res = run_cli(["run", "granite_ring", "--out", str(out), "--set", "initial.0.speed=1e200",
                    "--quiet"])
-    one_error(res, "initial[0].speed", "1e+200 m/s", "speed of light")
+    one_error(res, "initial.0.speed", "1e+200 m/s", "speed of light")
     assert not out.exists()
 
 

@@ -63,3 +63,18 @@ def test_show_refuses_what_is_not_built_in():
               "blast_demo")
     one_error(run_cli(["scenes", "--show", "blast_demo:no_such_case"]),
               "no case 'no_such_case' of 'blast_demo'", "rockmass")
+
+
+def test_error_key_pastes_back_into_set(tmp_path):
+    """A key an error names (here in a file, the second part's dx) is the ``--set``
+    spelling: passed back as ``--set KEY=VALUE`` it fixes that very value."""
+    text = sc.builtin_scenes()["blast_demo"].read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("dx = 3.0e-4", "dx = -3.0e-4"))      # the tube, parts.1
+    line = one_error(run_cli(["check", str(bad)]), "must be > 0")
+    key = line.removeprefix("mpipd: error: ").split(":", 1)[0]
+    assert key == "parts.1.dx"
+    res = run_cli(["check", str(bad), "--set", f"{key}=3.0e-4"])
+    assert res.returncode == 0, res.stderr
+    scene = sc.load(str(bad), [f"{key}=3.0e-4"])[0]
+    assert scene == sc.load("blast_demo")[0]

@@ -220,13 +220,13 @@ def test_unknown_function_is_a_one_line_error():
     with pytest.raises(SceneError) as e:
         make_scene(d)
     msg = str(e.value)
-    assert msg.startswith("parts[0].influence: unknown influence function 'cubic'")
+    assert msg.startswith("parts.0.influence: unknown influence function 'cubic'")
     assert "quadratic" in msg and "constant" in msg and "inverse" in msg
     assert "\n" not in msg
 
 
 def test_gas_parts_keep_the_quadratic_function():
-    with pytest.raises(SceneError, match=r"^parts\[0\]\.influence: the explosive gas"):
+    with pytest.raises(SceneError, match=r"^parts\.0\.influence: the explosive gas"):
         sc.load("blast_demo", ['parts.0.influence="constant"'])
     assert sc.load("blast_demo", ['parts.1.influence="constant"'])[0].parts[1].influence \
         == "constant"

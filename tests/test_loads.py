@@ -107,5 +107,5 @@ def test_gaussian_velocity_kinetic_energy(team):
 
 @pytest.mark.parametrize("sigma", [0.0, -1e-3])
 def test_gaussian_velocity_needs_positive_sigma(sigma):
-    with pytest.raises(SceneError, match=r"^initial\[0\]\.sigma: must be > 0"):
+    with pytest.raises(SceneError, match=r"^initial\.0\.sigma: must be > 0"):
         make_scene(gaussian_scene(sigma=sigma))

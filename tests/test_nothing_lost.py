@@ -124,7 +124,7 @@ def test_an_early_stop_keeps_frames_written_after_the_checkpoint(tmp_path):
     ('output.fields=["u","v","stress"]', "output.fields"),
     ("materials.granite.bulk_modulus=30e9", "materials.granite.bulk_modulus"),
     ("materials.granite.density=5000", "materials.granite.density"),
-    ("parts.0.shape.hi=[0.016, 0.192, 0.016]", "parts[0].shape.hi"),
+    ("parts.0.shape.hi=[0.016, 0.192, 0.016]", "parts.0.shape.hi"),
     ("solver.hourglass=0.02", "solver.hourglass"),
     ('probes=[{name="a", position=[0.05, 0.008, 0.008]}]', "probes"),
     ("output.peak_center=[0.1, 0.0]", "output.peak_center"),
@@ -203,7 +203,7 @@ def test_bad_input_leaves_no_folder(tmp_path):
     out = tmp_path / "new"
     res = run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set",
                    'probes=[{name="far", position=[0.5, 0.0, 0.0]}]'])
-    one_error(res, "probes[0].position")
+    one_error(res, "probes.0.position")
     assert not out.exists()
 
 
@@ -257,7 +257,7 @@ def small_fs(tmp_path):
     ("time.t_end=1e30", ("needs about", "--force-size")),
     ("time.steps=99999999999999999999", ("time.steps: must be below 2^63",)),
     ("output.every=99999999999999999999", ("output.every: must be below 2^63",)),
-    ("parts.0.jitter_seed=9999999999999999999", ("parts[0].jitter_seed: must be below 2^63",)),
+    ("parts.0.jitter_seed=9999999999999999999", ("parts.0.jitter_seed: must be below 2^63",)),
 ])
 def test_too_big_for_the_disk_is_refused_before_overwrite_deletes(small_fs, setting, needles):
     """An existing run on a 20 MB file system and --overwrite with a run file of

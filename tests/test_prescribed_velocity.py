@@ -126,9 +126,9 @@ def test_a_ramp_gives_the_ramped_displacement_and_work(team):
 
 
 def test_bad_input_is_refused():
-    with pytest.raises(SceneError, match=r"boundaries\[0\]\.ramp"):
+    with pytest.raises(SceneError, match=r"boundaries\.0\.ramp"):
         bar(ramp=-1e-6)
-    with pytest.raises(SceneError, match=r"boundaries\[0\]\.velocity"):
+    with pytest.raises(SceneError, match=r"boundaries\.0\.velocity"):
         bar(velocity=(3e8, 0.0, 0.0))
 
 

@@ -38,7 +38,7 @@ def test_unknown_part_is_a_one_line_scene_error():
     with pytest.raises(SceneError) as e:
         make_scene(d)
     msg = str(e.value)
-    assert msg.startswith("probes[1].part: no part 'granit'") and "\n" not in msg
+    assert msg.startswith("probes.1.part: no part 'granit'") and "\n" not in msg
     assert "rock" in msg and "tube" in msg
 
 

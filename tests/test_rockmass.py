@@ -217,14 +217,14 @@ BAD = [
     ('materials.granite.heterogeneity={distribution="lognormal",applies_to=["T"]}',
      "materials.granite.heterogeneity.distribution", "unknown distribution"),
     ('materials.granite.heterogeneity={distribution="weibull",modulus=6.0,applies_to=["K1"]}',
-     "materials.granite.heterogeneity.applies_to[0]", "unknown target"),
+     "materials.granite.heterogeneity.applies_to.0", "unknown target"),
     ('materials.granite.heterogeneity={distribution="weibull",modulus=6.0}',
      "materials.granite.heterogeneity.applies_to", "missing value"),
-    ("parts.0.jitter=0.5", "parts[0].jitter", "must be in [0, 0.5)"),
-    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,0.0,0.0]}]', "joints[0].normal", "non-zero"),
-    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,1.0,0.0],persistence=0.5}]', "joints[0].patch",
+    ("parts.0.jitter=0.5", "parts.0.jitter", "must be in [0, 0.5)"),
+    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,0.0,0.0]}]', "joints.0.normal", "non-zero"),
+    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,1.0,0.0],persistence=0.5}]', "joints.0.patch",
      "patch size"),
-    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,1.0,0.0],parts=["tube"]}]', "joints[0].parts[0]",
+    ('joints=[{point=[0.0,0.0,0.0],normal=[0.0,1.0,0.0],parts=["tube"]}]', "joints.0.parts.0",
      "no part"),
 ]
 
@@ -240,7 +240,7 @@ def test_a_target_the_material_lacks_and_joints_without_contact(tmp_path):
     out = tmp_path / "out"
     h = 'materials.granite.heterogeneity={distribution="uniform",width=0.1,applies_to=["T"]}'
     check_bad(run_cli(["run", "elastic_wave", "--out", str(out), "--set", h]), out,
-              "materials.granite.heterogeneity.applies_to[0]", "no strength 'T'")
+              "materials.granite.heterogeneity.applies_to.0", "no strength 'T'")
     j = 'joints=[{point=[0.0,0.0,0.0],normal=[1.0,0.0,0.0]}]'
     check_bad(run_cli(["run", "elastic_wave", "--out", str(out), "--set", j]), out,
               "solver.contact", "joints need contact")

@@ -134,11 +134,11 @@ def existing(tmp_path_factory):
     (["--stop-after", "0"], ("--stop-after must be a step >= 1",)),
     (["--stop-after", "-5"], ("--stop-after must be a step >= 1",)),
     (["--set", 'probes=[{name="far", position=[0.5, 0.0, 0.0]}]'],
-     ("probes[0].position", "beyond its horizon")),
+     ("probes.0.position", "beyond its horizon")),
     (["--set", 'loads=[{kind="borehole_pressure", center=[0.0, 0.0], radius=0.5, p0=1e8, '
-               'alpha=1e5, beta=2e5}]'], ("loads[0].radius", "meets no part")),
+               'alpha=1e5, beta=2e5}]'], ("loads.0.radius", "meets no part")),
     (["--set", 'loads=[{kind="borehole_pressure", center=[0.01, 0.01], radius=0.003, p0=1e8, '
-               'alpha=1e5, beta=2e5}]'], ("loads[0].radius", "lands inside part")),
+               'alpha=1e5, beta=2e5}]'], ("loads.0.radius", "lands inside part")),
 ])
 def test_bad_run_input_changes_nothing(existing, args, needles):
     """One line, exit 2, and an existing run's files byte for byte unchanged."""

@@ -5,16 +5,16 @@ from conftest import check_bad, run_cli
 from mpipd.input import scene as sc
 
 CASES = [
-    (["--set", "parts.0.radus=1"], "parts[0].radus", "unknown key"),
-    (["--set", 'parts.0.dx="abc"'], "parts[0].dx", "expected a number"),
-    (["--set", "parts.0.dx=-0.001"], "parts[0].dx", "must be > 0"),
-    (["--set", "parts.0.horizon_factor=0.5"], "parts[0].horizon_factor", "at least dx"),
-    (["--set", 'parts.0.influence="cubic"'], "parts[0].influence", "unknown influence function"),
+    (["--set", "parts.0.radus=1"], "parts.0.radus", "unknown key"),
+    (["--set", 'parts.0.dx="abc"'], "parts.0.dx", "expected a number"),
+    (["--set", "parts.0.dx=-0.001"], "parts.0.dx", "must be > 0"),
+    (["--set", "parts.0.horizon_factor=0.5"], "parts.0.horizon_factor", "at least dx"),
+    (["--set", 'parts.0.influence="cubic"'], "parts.0.influence", "unknown influence function"),
     (["--set", "time.steps=-1"], "time.steps", "must be >= 0"),
     (["--set", "materials.granite.model=rubber"], "materials.granite.model", "unknown material"),
-    (["--set", "parts.0.material=basalt"], "parts[0].material", "no material"),
-    (["--set", "output.fields=[\"u\",\"temperature\"]"], "output.fields[1]", "unknown field"),
-    (["--set", "initial.0.axis=w"], "initial[0].axis", "must be one of"),
+    (["--set", "parts.0.material=basalt"], "parts.0.material", "no material"),
+    (["--set", "output.fields=[\"u\",\"temperature\"]"], "output.fields.1", "unknown field"),
+    (["--set", "initial.0.axis=w"], "initial.0.axis", "must be one of"),
     (["--set", "time.dt=true"], "time.dt", "expected a number"),
 ]
 
@@ -31,7 +31,7 @@ def test_missing_value(tmp_path):
     f = tmp_path / "s.toml"
     f.write_text(text)
     out = tmp_path / "out"
-    check_bad(run_cli(["run", str(f), "--out", str(out)]), out, "parts[0].dx", "missing value")
+    check_bad(run_cli(["run", str(f), "--out", str(out)]), out, "parts.0.dx", "missing value")
 
 
 def test_not_toml(tmp_path):
@@ -49,7 +49,7 @@ def test_unknown_scene(tmp_path):
 
 def test_check_reports_bad_scene_too(tmp_path):
     res = run_cli(["check", "elastic_wave", "--set", "parts.0.dx=-1"])
-    assert res.returncode == 2 and "parts[0].dx: must be > 0" in res.stderr
+    assert res.returncode == 2 and "parts.0.dx: must be > 0" in res.stderr
 
 
 def test_existing_output_is_not_overwritten(tmp_path):
@@ -65,16 +65,16 @@ def test_bad_scene_under_mpirun_one_message(tmp_path):
     out = tmp_path / "out"
     res = run_cli(["run", "elastic_wave", "--out", str(out), "--set", "parts.0.dx=0"],
                   ranks=2, timeout=120)
-    check_bad(res, out, "parts[0].dx", "must be > 0", mpirun=True)
+    check_bad(res, out, "parts.0.dx", "must be > 0", mpirun=True)
 
 
 GEOMETRY_CASES = [
     (["--set", "time.dt=inf"], "time.dt", "finite"),
-    (["--set", "parts.0.dx=nan"], "parts[0].dx", "finite"),
-    (["--set", "parts.0.shape.lo=[0,0,nan]"], "parts[0].shape.lo[2]", "finite"),
-    (["--set", "parts.0.dx=1e-9"], "parts[0].dx", "too small"),
+    (["--set", "parts.0.dx=nan"], "parts.0.dx", "finite"),
+    (["--set", "parts.0.shape.lo=[0,0,nan]"], "parts.0.shape.lo.2", "finite"),
+    (["--set", "parts.0.dx=1e-9"], "parts.0.dx", "too small"),
     (["--set", 'parts.0.shape={kind="cylinder", center=[0,0], radius=1e-4, z=[0,0.01]}'],
-     "parts[0].shape", "no lattice point"),
+     "parts.0.shape", "no lattice point"),
 ]
 
 

@@ -23,7 +23,7 @@ def test_check_refuses_a_probe_outside_the_body_with_runs_line(tmp_path):
     of a probe inside it."""
     out = tmp_path / "p"
     ran = one_error(run_cli(["run", "elastic_wave", "--out", str(out), *SMALL,
-                             "--set", OUTSIDE]), "probes[0].position", "outside the body")
+                             "--set", OUTSIDE]), "probes.0.position", "outside the body")
     assert not out.exists()
     checked = one_error(run_cli(["check", "elastic_wave", *SMALL[:-1], "--set", OUTSIDE]))
     assert checked == ran
@@ -43,7 +43,7 @@ def test_check_refuses_a_probe_outside_the_body_with_runs_line(tmp_path):
 def test_a_shape_thinner_than_half_a_spacing_holds_no_point_and_is_refused(tmp_path, shape):
     out = tmp_path / "g"
     line = one_error(run_cli(["run", "elastic_wave", "--out", str(out), *SMALL, "--set",
-                              shape]), "parts[0].shape", "holds no lattice point")
+                              shape]), "parts.0.shape", "holds no lattice point")
     assert not out.exists()
     assert one_error(run_cli(["check", "elastic_wave", *SMALL[:-1], "--set", shape])) == line
 
@@ -63,12 +63,12 @@ def test_every_lattice_point_of_a_box_lies_inside_it():
 
 @pytest.mark.parametrize("setting, key, what", [
     ('boundaries=[{kind="fixed", region={lo=[1.0, 1.0, 1.0], hi=[2.0, 2.0, 2.0]}}]',
-     "boundaries[0].region", "'fixed'"),
+     "boundaries.0.region", "'fixed'"),
     ('initial=[{kind="uniform_velocity", region={lo=[1.0, 1.0, 1.0], hi=[2.0, 2.0, 2.0]}, '
-     'velocity=[1.0, 0.0, 0.0]}]', "initial[0].region", "'uniform_velocity'"),
-    ("initial.0.center=1.0", "initial[0]", "'velocity_pulse'"),
+     'velocity=[1.0, 0.0, 0.0]}]', "initial.0.region", "'uniform_velocity'"),
+    ("initial.0.center=1.0", "initial.0", "'velocity_pulse'"),
     ('initial=[{kind="radial_velocity", center=[0.0, 0.0], r_inner=1.0, r_outer=2.0, '
-     'speed=1.0}]', "initial[0]", "'radial_velocity'"),
+     'speed=1.0}]', "initial.0", "'radial_velocity'"),
 ])
 def test_a_region_with_no_point_is_refused(tmp_path, setting, key, what):
     out = tmp_path / "r"
@@ -98,11 +98,11 @@ def test_a_region_on_another_ranks_points_is_not_empty(tmp_path):
      ["lies inside it", "1984 of its 3968 points"]),
     ("materials.explosive.initiation_z=-0.01", "materials.explosive.initiation_z",
      ["lies outside it", "10.2 mm before its first point"]),
-    ("parts.0.initiation={z=0.0, time=1e-3}", "parts[0].initiation.time",
+    ("parts.0.initiation={z=0.0, time=1e-3}", "parts.0.initiation.time",
      ["first lit at 1000 us", "t_end = 2.4 us", "initiation.never"]),
-    ("parts.0.initiation={point=[0.0, 0.0, 0.5]}", "parts[0].initiation.point",
+    ("parts.0.initiation={point=[0.0, 0.0, 0.5]}", "parts.0.initiation.point",
      ["outside it"]),
-    ("parts.0.initiation={never=true, time=1.0}", "parts[0].initiation.never", []),
+    ("parts.0.initiation={never=true, time=1.0}", "parts.0.initiation.never", []),
 ])
 def test_a_charge_lit_from_outside_it_or_after_t_end_is_refused(tmp_path, setting, key,
                                                                   needles):

@@ -416,13 +416,13 @@ def check_parts(parts) -> None:
     for k, part in enumerate(parts):
         est = part.shape.area / part.dx ** 2
         if est > MAX_SECTION_POINTS:
-            fail(f"parts[{k}].dx", f"gives ~{est:.3g} points per z level "
+            fail(f"parts.{k}.dx", f"gives ~{est:.3g} points per z level "
                                    f"(at most {MAX_SECTION_POINTS:.0e}); dx is too small")
         pts = (part.shape.cross_section(part.dx) if part.shape.prism
                else part_points(part))
         n = len(pts[0]) if part.shape.prism else len(pts)
         if n == 0 or len(part.shape.z_levels(part.dx)) == 0:
-            fail(f"parts[{k}].shape", f"part {part.name!r} holds no lattice point at "
+            fail(f"parts.{k}.shape", f"part {part.name!r} holds no lattice point at "
                                       f"dx = {part.dx} (shape smaller than the lattice)")
         sections.append(pts)
     for a in range(len(parts)):
@@ -440,7 +440,7 @@ def check_parts(parts) -> None:
                 pts = sections[a] if not parts[a].shape.prism else part_points(parts[a])
                 hit = np.any(parts[b].shape.contains(pts[:, 0], pts[:, 1], pts[:, 2], margin))
             if hit:
-                fail(f"parts[{a}]", f"part {parts[a].name!r} overlaps part {parts[b].name!r}")
+                fail(f"parts.{a}", f"part {parts[a].name!r} overlaps part {parts[b].name!r}")
 
 
 def fill_layers(parts, table: LayerTable, layers: np.ndarray):

@@ -291,7 +291,7 @@ def regions(scene) -> list[tuple[str, object]]:
     """(key, condition) of every initial and boundary condition that acts on a part of
     the body (those with ``selects(x)``: a region, a slab, a ring, a layer), each of
     which must hold a point (:func:`refuse_empty`; a gaussian_velocity acts everywhere)."""
-    return [(join(f"{kind}[{i}]", c.region_key) if c.region_key else f"{kind}[{i}]", c)
+    return [(join(f"{kind}.{i}", c.region_key) if c.region_key else f"{kind}.{i}", c)
             for kind, conds in (("initial", scene.initial), ("boundaries", scene.boundaries))
             for i, c in enumerate(conds) if hasattr(c, "selects")]
 
@@ -363,7 +363,7 @@ class BoreholePressure:
         for k, part in enumerate(parts):
             if not part.shape.prism:
                 fail(path, f"a borehole pressure needs parts that are prisms along z; part "
-                     f"{part.name!r} is not (parts[{k}].shape): a charge along another axis "
+                     f"{part.name!r} is not (parts.{k}.shape): a charge along another axis "
                      "is an explosive part (the gas)")
         for part in parts:
             sx, sy = part.shape.cross_section(part.dx)

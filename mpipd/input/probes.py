@@ -80,10 +80,10 @@ def placed(k, pr, found) -> str | None:
     than its horizon (outside the body); the run log's warning (:func:`snap_note`)
     if it moved more than SNAP_WARN dx; else None."""
     if not math.isfinite(found[0]):
-        fail(f"probes[{k}].part", f"probe {pr.name!r}: no point of part {pr.part!r}")
+        fail(f"probes.{k}.part", f"probe {pr.name!r}: no point of part {pr.part!r}")
     dist, _, xg, _, _, dxg, hg = found
     if dist > hg:
-        fail(f"probes[{k}].position", f"probe {pr.name!r}: the nearest point"
+        fail(f"probes.{k}.position", f"probe {pr.name!r}: the nearest point"
              f"{' of part ' + repr(pr.part) if pr.part else ''} is {dist * 1e3:.3g} mm "
              f"away, beyond its horizon ({hg * 1e3:.3g} mm): outside the body?")
     if dist > SNAP_WARN * dxg:     # more than half a lattice spacing: say so

@@ -54,7 +54,7 @@ def _diff(a, b, path: str, out: list) -> None:
             out.append(path)
             return
         for i, (x, y) in enumerate(zip(a, b)):
-            _diff(x, y, f"{path}[{i}]", out)
+            _diff(x, y, f"{path}.{i}", out)
         return
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
         if not (np.shape(a) == np.shape(b) and np.array_equal(a, b)):

@@ -410,18 +410,18 @@ class Scene:
         names = set()
         for i, p in enumerate(self.parts):
             if p.material not in self.materials:
-                fail(f"parts[{i}].material",
+                fail(f"parts.{i}.material",
                      f"no material {p.material!r} (defined: {', '.join(self.materials)})")
             if p.name in names:
-                fail(f"parts[{i}].name", f"duplicate part name {p.name!r}")
+                fail(f"parts.{i}.name", f"duplicate part name {p.name!r}")
             if p.influence != "quadratic" and p.material in self.gas_materials:
-                fail(f"parts[{i}].influence", "the explosive gas (updated-Lagrangian) always "
+                fail(f"parts.{i}.influence", "the explosive gas (updated-Lagrangian) always "
                                               "uses the quadratic influence function")
             names.add(p.name)
         gas = self.gas_materials
         for i, p in enumerate(self.parts):
             if p.initiation is not None and p.material not in gas:
-                fail(f"parts[{i}].initiation", f"only a charge (a part of an explosive, jwl, "
+                fail(f"parts.{i}.initiation", f"only a charge (a part of an explosive, jwl, "
                                                f"material) is initiated; {p.material!r} is not")
         if len(gas) > 1:
             fail("materials", f"one explosive (jwl) material at most (got {', '.join(gas)})")
@@ -431,16 +431,16 @@ class Scene:
                     fail(f"materials.{m}.interacts_with", f"no other material {a!r}")
         for i, ld in enumerate(self.loads):
             if hasattr(ld, "check_parts"):          # loads placed on the geometry
-                ld.check_parts(self.parts, f"loads[{i}]")
+                ld.check_parts(self.parts, f"loads.{i}")
         for i, jt in enumerate(self.joints):
-            jt.check_parts(self.parts, f"joints[{i}]")
+            jt.check_parts(self.parts, f"joints.{i}")
         gas = set(self.gas_materials)
         solids = {p.material for p in self.parts} - gas
         for i, bc in self.absorbing_layers:
             for m in sorted(solids):
                 cd = float(bc.c_max(self.materials[m].p_wave_speed)) * self.time.dt
                 if cd > 2.0:
-                    fail(f"boundaries[{i}].thickness",
+                    fail(f"boundaries.{i}.thickness",
                          f"the layer's damping at the face, c_max dt = {cd:.3g} for {m!r}, "
                          f"exceeds 2 (the damped update then reverses velocities): "
                          f"make the layer thicker or the reflection larger")
@@ -450,12 +450,12 @@ class Scene:
         seen = set()
         for i, pr in enumerate(self.probes):
             if pr.name in seen or not pr.name.isidentifier():
-                fail(f"probes[{i}].name", f"probe names must be unique identifiers ({pr.name!r})")
+                fail(f"probes.{i}.name", f"probe names must be unique identifiers ({pr.name!r})")
             seen.add(pr.name)
             if pr.part is not None and not any(part_matches(pr.part, p.name)
                                                for p in self.parts):
                 known = ", ".join(p.name for p in self.parts)
-                fail(f"probes[{i}].part", f"no part {pr.part!r} (parts: {known})")
+                fail(f"probes.{i}.part", f"no part {pr.part!r} (parts: {known})")
         mr = self.time.multirate
         if mr is not None and mr.max_ratio > 1:
             r = mr.max_ratio
@@ -474,7 +474,7 @@ class Scene:
                 what = {"failure": "a material that can fail (jh2, or a tension model)",
                     "jh2": "a jh2 material", "plastic": "a jh2 or j2 material",
                     "pressure": "a jh2 or jwl material", "gas": "a jwl material"}[need]
-                fail(f"output.fields[{i}]", f"{f!r} needs {what}")
+                fail(f"output.fields.{i}", f"{f!r} needs {what}")
 
     @property
     def name(self) -> str:

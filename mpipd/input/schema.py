@@ -3,7 +3,7 @@
 Every scene table maps to a frozen dataclass.  :func:`build` walks the
 dataclass fields, so
 
-* an unknown key is an error naming the key (``parts[0].radus: unknown key``),
+* an unknown key is an error naming the key (``parts.0.radus: unknown key``, the key as ``--set`` spells it),
 * a missing value is an error naming the key,
 * a wrong type is an error naming the key, the expected and the given type,
 * each dataclass may define ``check(self, path)`` for range checks, raising
@@ -35,8 +35,8 @@ def fail(path: str, reason: str) -> typing.NoReturn:
 
 
 def join(path: str, key) -> str:
-    if isinstance(key, int):
-        return f"{path}[{key}]"
+    """A key's path as ``--set`` spells it: ``parts.1.dx`` (an array's entries by
+    number, as tables' keys), so that an error's key can be pasted back."""
     return f"{path}.{key}" if path else str(key)
 
 

@@ -106,14 +106,14 @@ def check_charges(scene) -> None:
         if ini is not None and ini.point is not None:
             d = float(np.linalg.norm(pts - np.asarray(ini.point), axis=1).min())
             if d > q.dx:
-                fail(f"parts[{k}].initiation.point",
+                fail(f"parts.{k}.initiation.point",
                      f"the primer point {list(ini.point)} m lies {d * 1e3:.3g} mm from the "
                      f"nearest point of charge {q.name!r} (more than its dx, "
                      f"{q.dx * 1e3:.3g} mm): outside it, lit {d / mat.vod * 1e6:.3g} us late")
         else:
             z0, sign = (ini.z, ini.direction) if ini is not None else (mat.initiation_z,
                                                                         mat.direction)
-            key = (f"parts[{k}].initiation.z" if ini is not None
+            key = (f"parts.{k}.initiation.z" if ini is not None
                    else f"materials.{q.material}.initiation_z")
             lo, hi = float(pts[:, 2].min()) - 0.5 * q.dx, float(pts[:, 2].max()) + 0.5 * q.dx
             face = lo if sign > 0 else hi
@@ -133,7 +133,7 @@ def check_charges(scene) -> None:
         first = float(lighting_times(scene, np.full(len(pts), k), pts, mat).min())
         if not first < t_end:
             timed = ini is not None and ini.time > 0
-            fail(f"parts[{k}].initiation" + (".time" if timed else ""),
+            fail(f"parts.{k}.initiation" + (".time" if timed else ""),
                  f"charge {q.name!r} is first lit at {first * 1e6:.4g} us, not before the "
                  f"run's end t_end = {t_end * 1e6:.4g} us: none of it burns in this run (run "
                  "to its time and stop earlier with --stop-after, or set initiation.never = "
