@@ -460,7 +460,7 @@ def test_crushed_zone_at_first_damage(tmp_path):
     assert row["crushed_zone"]["value"] == pytest.approx(7.0 / 3)
     assert row["crushed_zone"]["verdict"] == "information"
     write_run(path, failed=rock & (r < 10e-3), frames=2)
-    make_report(path, tmp_path / "rep", MPI.COMM_SELF)
+    make_report(path, tmp_path / "rep", MPI.COMM_SELF, paper=True)
     md = (tmp_path / "rep" / "report.md").read_text()
     assert ("Not available: no saved frame within 1 µs of 4 µs (the nearest is at 0 µs)."
             in md.split("### Crushed zone at first damage")[1])
@@ -903,7 +903,7 @@ def test_arrivals_out_of_order_are_an_error(tmp_path):
     assert "first-pulse peak times do not increase" in (
         ws["first_pulse_peak_arrival"]["not_available"])
     assert [e["measure"] for e in m["errors"]] == ["wave speed (first arrivals)"]
-    make_report(path, tmp_path / "rep", MPI.COMM_SELF)
+    make_report(path, tmp_path / "rep", MPI.COMM_SELF, paper=True)
     md = (tmp_path / "rep" / "report.md").read_text()
     assert md.index("## Errors") < md.index("## Targets")
     assert "first-arrival times do not increase" in md.split("## Targets")[0]
@@ -966,7 +966,7 @@ def test_negative_energies_are_errors(tmp_path):
     assert "energy ledger: closure" not in [e["measure"] for e in m["errors"]]
     with h5py.File(path, "r+") as f:
         f["energy"]["balance"][...] = [0.0, 1e-4, -3e-3, 2e-3, 1e-3]
-    make_report(path, tmp_path / "rep", MPI.COMM_SELF)
+    make_report(path, tmp_path / "rep", MPI.COMM_SELF, paper=True)
     md = (tmp_path / "rep" / "report.md").read_text()
     assert "| kinetic | **error**" in md and "| elastic | 4 |" in md
     assert "Largest |balance|" in md and "0.003 at frame 2" in md
@@ -1018,7 +1018,7 @@ def test_every_step_peaks_and_ledger_are_the_same_on_1_and_2_reading_ranks(tmp_p
     write_run(tmp_path / "run.h5", v_rock=1.5, w_rock=0.7)
     docs = []
     for n in (1, 2):
-        res = post(n, "report", str(tmp_path / "run.h5"), "--out", str(tmp_path / f"r{n}"))
+        res = post(n, "report", str(tmp_path / "run.h5"), "--out", str(tmp_path / f"r{n}"), "--paper")
         assert res.returncode == 0, res.stderr
         docs.append((tmp_path / f"r{n}" / "report.json").read_text())
     assert docs[0] == docs[1]

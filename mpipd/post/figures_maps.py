@@ -43,6 +43,10 @@ def _damage_panel(ax, sec, key, model, title):
     return im
 
 
+#: the rows of Fig. 11's damage picture (sections.NAMED: 5 mm, mid-thickness, T - 5 mm)
+FIG11_ROWS = (NAMED[1], NAMED[2], NAMED[3])
+
+
 def _damage_grid(data, model, times, frames, rows, label, what, out) -> str:
     """rows = section names, columns = frames."""
     plt = pyplot()

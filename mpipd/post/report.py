@@ -48,8 +48,11 @@ def _figures(metrics, data, model, times, label, out: Path) -> tuple[dict, dict]
     no_dmg = None if has_damage else "the run has no damage field"
     put("fig09_fracture_faces", no_dmg, fmap.fracture_pattern, sec, model, times, frames, label,
         out / "fig09_fracture_faces.png")
-    put("fig11_fracture_sections", no_dmg, fmap.fracture_sections, sec, model, times, frames,
-        label, out / "fig11_fracture_sections.png")
+    fig11 = [n for n in fmap.FIG11_ROWS if n in sec["levels"]]
+    put("fig11_fracture_sections", no_dmg or (None if fig11 else "no Fig. 11 section in the rock "
+                                              "(the rock is thinner than its sections)"),
+        fmap.fracture_sections, sec, model, times, frames, label,
+        out / "fig11_fracture_sections.png")
     put("fig13_failure_modes", None if has_mode else "the run has no failure_mode field",
         fmap.failure_modes, sec, model, times, last, label, out / "fig13_failure_modes.png")
     put("fig12_crack_density", fr.get("not_available"), fc.crack_density, fr, label,
