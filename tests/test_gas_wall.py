@@ -8,7 +8,7 @@ from conftest import restart_matches, run_cli
 
 from mpipd.input import scene as sc
 from mpipd.kernels.ul import gas_gather
-from mpipd.kernels.wall import DEPTH, wall_gather, wall_update
+from mpipd.kernels.wall import DEPTH, EDGE, wall_gather, wall_update
 
 KC = 2.0 * 7.3e10          # stiffness x rho0 vod^2 (Pa)
 L_GAS, L_WALL, DELTA = 4.0e-4, 3.0e-4, 1.5e-3
@@ -122,20 +122,24 @@ def test_the_stretched_plate_holds_where_the_point_contact_does_not():
 
 def test_no_force_beyond_the_wall_or_past_its_edge():
     """A gas point more than DEPTH spacings behind the face has passed the wall; one
-    whose foot lies beyond the plate's edge (out of an open end) is not over it: no
-    force on either.  Over the plate's last row the force is still whole."""
+    EDGE gas spacings beyond the plate's last row (out of an open end) is not over it:
+    no force on either.  Over the last row the force is whole, and half way to EDGE it
+    is half, along the plate's normal (the plane is the plate's)."""
     R = np.eye(3)
     half = 3 * L_WALL                                    # the 7 x 7 plate's half width
     g0 = np.full(1, 0.5 * L_GAS)
     behind = np.array([0.0, 0.0, 0.5 * L_WALL - (DEPTH + 0.1) * L_GAS])
     assert wall_forces(scene_arrays(behind, L_WALL, R), g0.copy())[1] == 0
-    beyond = np.array([half + 0.5 * DELTA, 0.0, 2.0e-4])
+    beyond = np.array([half + 0.25 * L_GAS + EDGE * L_GAS, 0.0, 2.0e-4])
     assert wall_forces(scene_arrays(beyond, L_WALL, R), g0.copy())[1] == 0
+    partly = np.array([half + 0.5 * EDGE * L_GAS, 0.0, 2.0e-4])   # e = 1/2
+    f_half = wall_forces(scene_arrays(partly, L_WALL, R), g0.copy())[0][0]
     over_edge = np.array([half, 0.0, 2.0e-4])
     f, on, _ = wall_forces(scene_arrays(over_edge, L_WALL, R), g0.copy())
     assert on == 1
-    np.testing.assert_allclose(f[0, 2], KC * L_GAS * (g0[0] - (2.0e-4 - 0.5 * L_WALL)),
-                               rtol=0.05)       # the half disc's foot: the plane is the plate's
+    F = KC * L_GAS * (g0[0] - (2.0e-4 - 0.5 * L_WALL))
+    np.testing.assert_allclose(f[0], [0.0, 0.0, F], rtol=1e-9, atol=1e-9 * F)
+    np.testing.assert_allclose(f_half, [0.0, 0.0, 0.5 * F], rtol=1e-9, atol=1e-9 * F)
 
 
 def test_a_wall_material_outside_interacts_with_is_refused():

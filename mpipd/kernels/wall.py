@@ -13,22 +13,29 @@ and S = sum w_j:
               the least)
     h       = sum w_j l_j / (2 S)                    half the wall's spacing: its face
     g       = (y_i - c) . n - h                      the gap to the face
-    t       = |(y_i - c) - ((y_i - c) . n) n| / delta_i   the foot's offset along the face
-    F_i     = e(t) k l_i (g_0 - g) n   if -DEPTH l_i < g < g_0, else 0
+    t       = (c - y_i) - ((c - y_i) . n) n          the foot's offset along the face
+    s       = max_j (y_i - y_j) . t / |t|            how far the wall reaches past y_i
+                                                     away from its foot
+    F_i     = e(s) k l_i (g_0 - g) n   if -DEPTH l_i < g < g_0, else 0
 
 (k = stiffness x rho0 vod^2, l_i the gas point's lattice spacing, g_0 its standoff,
 set at its first evaluation to min(distance l_i, g), or to distance l_i for a gas
 point with no wall in reach then).  The wall point j takes
 -F_i w_j / S: the pair forces sum to zero.  A gas point deeper than DEPTH of its
 spacing behind the face has passed the wall and is left to the gas (pulling it back
-through the wall would be a force of a passed point, not of a wall).  Nor is a gas
+through the wall would be a force of a passed point, not of a wall: with DEPTH = 2 the
+stretched tube of the paper's reduction shot such points back at 10-12 km/s, 5-8 J
+each, studies/validation/notes.md §51).  Nor is a gas
 point beyond the wall's edge (out of an open end of the tube, venting): the plane
 fitted over the wall points near an edge extends beyond it, and a gas point flowing
-round the end would be pushed back by a wall that is not there.  Over a wall the
-weighted foot lies under the gas point (t ~ 0; a point over the last row of an
-edge has t ~ 0.4, the centroid of a half disc); the factor e(t) is 1 up to
-EDGE[0], falls linearly to 0 at EDGE[1] (half a gas spacing beyond the edge for the
-paper's charge) and is 0 beyond.
+round the end would be pushed back by a wall that is not there.  Over a wall, dense
+or stretched sparse, wall points lie on every side of the gas point, so some lie
+past it on the side away from the weighted foot: s > 0.  Over the last row of an edge
+s ~ 0; beyond the edge every wall point lies behind it, s < 0.  The factor e(s) is 1
+for s >= 0, falls linearly to 0 at s = -EDGE l_i and is 0 beyond (t = 0, a foot
+right under the point: e = 1).  It depends on where the wall's points are, not on
+how far apart they are (an earlier factor on |t| / delta fluctuated between a
+stretched wall's rows and pumped energy in: studies/validation/notes.md §51).
 
 :func:`wall_update` makes F_i and F_i / S (the halo carries the latter to the wall
 points' owners) for the owned gas; :func:`wall_gather` adds every owned point's
@@ -44,9 +51,33 @@ from .index import family, neighbour
 #: a middle spread at least PLANAR times the least: the points span a plane
 PLANAR = 4.0
 #: a gas point more than DEPTH of its spacing behind the face has passed the wall
-DEPTH = 2.0
-#: the foot's offset along the face, / delta, where the force starts to fall and is 0
-EDGE = (0.4, 0.55)
+DEPTH = 0.5
+#: beyond the wall's edge by EDGE gas spacings (s = -EDGE l_i) the force is 0
+EDGE = 0.5
+
+
+@numba.njit(cache=True)
+def edge_factor(i, y, offsets, nbr, is_wall, di, t0, t1, t2, li):
+    """e(s) of the module docstring for gas point i whose foot is offset by
+    t = (t0, t1, t2) along the face: s = max over its wall points within di of
+    (y_i - y_j) . t / |t|."""
+    lt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    if lt == 0.0:
+        return 1.0
+    s = -math.inf
+    for b in range(*family(offsets, i)):
+        j = neighbour(nbr, b)
+        if not is_wall[j]:
+            continue
+        y0 = y[j, 0] - y[i, 0]
+        y1 = y[j, 1] - y[i, 1]
+        y2 = y[j, 2] - y[i, 2]
+        if math.sqrt(y0 * y0 + y1 * y1 + y2 * y2) >= di:     # as in wall_update
+            continue
+        s = max(s, -(y0 * t0 + y1 * t1 + y2 * t2) / lt)
+    if s >= 0.0:
+        return 1.0
+    return max(0.0, 1.0 + s / (EDGE * li))
 
 
 @numba.njit(cache=True)
@@ -136,19 +167,17 @@ def wall_update(gas_idx, y, offsets, nbr, is_wall, N_ref, l_wall, delta, ell, g0
                 n0, n1, n2 = m0, m1, m2
         d = -(c0 * n0 + c1 * n1 + c2 * n2)     # (y_i - c) . n
         g = d - 0.5 * hl / S
-        t0 = -c0 - d * n0
-        t1 = -c1 - d * n1
-        t2 = -c2 - d * n2
-        t = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2) / di
         li = ell[k]
         if math.isnan(g0[k]):
             g0[k] = min(frac * li, g)
-        if g >= g0[k] or g <= -DEPTH * li or t >= EDGE[1]:
+        if g >= g0[k] or g <= -DEPTH * li:
+            continue
+        e = edge_factor(gas_idx[k], y, offsets, nbr, is_wall, di, c0 + d * n0,
+                        c1 + d * n1, c2 + d * n2, li)
+        if e == 0.0:
             continue
         pen = g0[k] - g
-        F = kc * li * pen
-        if t > EDGE[0]:
-            F *= (EDGE[1] - t) / (EDGE[1] - EDGE[0])
+        F = e * kc * li * pen
         gF[i, 0] = F * n0
         gF[i, 1] = F * n1
         gF[i, 2] = F * n2
