@@ -8,7 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import tomllib
+from conftest import child_env
 
 from mpipd.post.targets import TARGETS
 from mpipd.post.validation import judged
@@ -65,3 +67,23 @@ def test_links_exist():
         if "://" in target:
             continue
         assert (ROOT / target).exists(), f"README links a missing file: {target}"
+
+
+@pytest.mark.mpi
+def test_commands_of_your_own_run_as_printed(tmp_path):
+    """The README's commands after the scene of your own, run by bash as printed (the
+    virtualenv's path made absolute), with no Open MPI variable in the environment:
+    its own export lines are what lets mpirun run as root and on more ranks than cores."""
+    scene = re.search(r"```toml\n(.*?)```", README, re.S).group(1)
+    (tmp_path / "my_block.toml").write_text(scene)
+    block = re.search(r"```\n(\. \.venv/bin/activate\n.*?)```", README.split(scene, 1)[1],
+                      re.S).group(1)
+    assert "mpirun -n 2 mpipd run my_block.toml" in block
+    assert block.index("export OMPI_ALLOW_RUN_AS_ROOT=1") < block.index("mpirun")
+    script = block.replace(". .venv/bin/activate", f". {ROOT / '.venv' / 'bin' / 'activate'}")
+    env = {k: v for k, v in child_env().items() if not k.startswith("OMPI_")}
+    res = subprocess.run(["bash", "-e", "-c", script], capture_output=True, text=True,
+                         timeout=600, cwd=tmp_path, env=env)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert (tmp_path / "runs" / "my_block" / "run.h5").is_file()
+    assert "my_block" in res.stdout
