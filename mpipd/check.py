@@ -388,6 +388,15 @@ def check_report(scene, ranks: int) -> str:
                 f"x overlap (the ledger's gas_contact); omega dt = {wdt:.3g} for a gas point "
                 f"pressed on 6 solids (velocity Verlet is stable below 2)"
                 if frac > 0 else "none (gas may pass into the solids it acts on)"))
+            wf, wk = mat.wall_law
+            # the wall's spring k l on one gas point of mass rho l^3: omega dt
+            wdt = math.sqrt(wk / mat.density) / p.dx * scene.time.dt
+            out.append("    wall: " + (
+                f"held by the inner surface of {mat.wall.material!r}: a gas point nearer its "
+                f"face than min({wf:g} l, its first gap) is pushed back with "
+                f"{wk / 1e9:.3g} GPa x l x overlap (the ledger's gas_wall); omega dt = "
+                f"{wdt:.3g} (velocity Verlet is stable below 2)"
+                if wf > 0 else "none (nothing pushes the gas back from a tube's surface)"))
         if p.jitter > 0:
             out.append(f"    jitter: each point moved up to {p.jitter:g} dx = {p.jitter * p.dx:.3g} m "
                        f"on each axis (seed {p.jitter_seed}); bond counts are the lattice's")

@@ -110,7 +110,7 @@ def test_run_refuses_exactly_above_the_step_check_reports(tmp_path):
     assert above.returncode == 2 and "exceeds the stable estimate" in above.stderr
     chk = run_cli(["check", "elastic_wave", "--set", "parts.0.dx=0.004",
                    "--set", f"time.dt={dt_c * 1.001!r}"])
-    assert chk.returncode == 0 and "TOO LARGE" in chk.stdout
+    assert chk.returncode == 2 and "TOO LARGE" in chk.stdout    # check says so, exit 2
     assert f"stable {dt_c:.4e} s" in chk.stdout
     below = run_cli(["run", "elastic_wave", "--out", str(tmp_path / "b"), *base,
                      "--set", f"time.dt={dt_c * 0.999!r}"])
