@@ -20,7 +20,7 @@ help:
 	@echo "make install      set-up once: Debian Open MPI + parallel HDF5, .venv, mpi4py, h5py, mpipd"
 	@echo "make demo         the built-in scene blast_demo on 2 ranks, its picture and report (runs/demo)"
 	@echo "make test         every test CI runs (serial, mpirun -n 2 and -n 3), under 20 minutes"
-	@echo "make test-quick   the serial unit tests only (no mpirun, no long cases)"
+	@echo "make test-quick   the serial unit tests only (no mpirun, no whole simulations), under 3 minutes"
 	@echo "make docs         the documentation site from docs/ into site/, strict"
 	@echo "make bench        throughput and memory of the kernels, beside LAMMPS"
 	@echo "make verify       error against run time of the verification problems, then make stability"
@@ -54,12 +54,15 @@ demo-figure:
 	mkdir -p docs/img && cp runs/demo/fracture.png docs/img/demo_fracture.png
 	@$(PY) -c "import h5py; print('demo-figure: run file at commit', h5py.File('runs/demo/run.h5', 'r').attrs['git_commit'][:7])"
 
+# the package's tests and those of the research scripts beside the studies (studies/tests)
 test: install paraview
-	$(PY) -m pytest -q -ra tests
+	$(PY) -m pytest -q -ra tests studies/tests
 
-# the serial tier: no test that launches mpirun (marker `mpi`, applied in tests/conftest.py)
+# the serial unit tier of the package, under 3 minutes: no test that launches mpirun
+# (marker `mpi`, applied in tests/conftest.py) and none that runs a whole simulation
+# (marker `slow`); make test runs them all
 test-quick: install
-	$(PY) -m pytest -q -ra -m "not mpi and not long" tests
+	$(PY) -m pytest -q -ra -m "not mpi and not long and not slow" tests
 
 bench: install lammps
 	$(PY) benchmarks/run.py

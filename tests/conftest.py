@@ -150,12 +150,18 @@ def pytest_addoption(parser):
 _MPIRUN = re.compile(r"\brun_cli\((?:[^()]|\([^()]*\))*?\branks\s*=|\brestart_matches\("
                      r"|\brun_mpi_script\(|[\[(=]\s*[\"']mpirun[\"']")
 _CALL = re.compile(r"\b([A-Za-z_]\w*)\(")
+#: what runs a simulation in a test's source (the `slow` marker, out of make test-quick):
+#: a Simulation built in-process, `mpipd run` through run_cli or an argument list that
+#: starts with "run", or the verification script
+_SIMULATES = re.compile(r"\bSimulation\(|\brun_cli\(\[\s*(?:[\"']run[\"']|\*SCENE\b)"
+                        r"|\bargs\s*=\s*\[\s*[\"']run[\"']|\bverify\.py\b")
 
 
-def _sources(item):
+def _sources(item, here=None):
     """The source of a test function, of every fixture it uses that is defined under
-    tests/, and of the functions of the test's own module that these call (transitively)."""
-    here = Path(__file__).resolve().parent
+    ``here`` (default tests/; studies/tests/conftest.py passes its own folder), and of
+    the functions of the test's own module that these call (transitively)."""
+    here = here or Path(__file__).resolve().parent
     module = getattr(item, "module", None)
     todo = [getattr(item, "function", None)]
     defs = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {}) or {}
@@ -183,11 +189,16 @@ def _sources(item):
 
 def pytest_collection_modifyitems(config, items):
     """Mark every test that launches mpirun (directly or through a fixture) ``mpi``, so
-    that ``-m "not mpi"`` (make test-quick) is the serial tier; skip the ``long`` ones
-    unless --long."""
+    that ``-m "not mpi"`` is the serial tier, and every test that runs a simulation
+    (:data:`_SIMULATES`, directly or through a fixture) ``slow``, so that ``-m "not mpi
+    and not long and not slow"`` (make test-quick) is the serial unit tier; skip the
+    ``long`` ones unless --long."""
     for item in items:
-        if any(_MPIRUN.search(src) for src in _sources(item)):
+        sources = _sources(item)
+        if any(_MPIRUN.search(src) for src in sources):
             item.add_marker(pytest.mark.mpi)
+        if any(_SIMULATES.search(src) for src in sources):
+            item.add_marker(pytest.mark.slow)
     if config.getoption("--long"):
         return
     skip = pytest.mark.skip(reason="a long stability case: run by `make stability` "

@@ -34,3 +34,20 @@ def test_no_test_module_imports_another():
     for path in HERE.glob("test_*.py"):
         text = path.read_text()
         assert not re.search(r"^\s*(from|import)\s+test_\w+", text, re.M), path.name
+
+
+def test_slow_marker_follows_simulations():
+    """`slow` (tests/conftest.py) is on the serial tests that run a simulation, directly
+    or through a fixture, and on no other: `make test-quick` leaves them to `make test`."""
+    slow = collected("-m", "slow", "tests/test_api.py", "tests/test_gas.py", "tests/test_verify.py")
+    every = collected("tests/test_api.py", "tests/test_gas.py", "tests/test_verify.py")
+    # test_api's run-file fixture runs blast_demo; two tests do without it
+    api = {t for t in every if t.startswith("tests/test_api.py")}
+    assert {t for t in slow if t.startswith("tests/test_api.py")} == api - {
+        "tests/test_api.py::test_import_mpipd_loads_no_reading_code",
+        "tests/test_api.py::test_not_a_run_file_is_one_clear_error"}
+    assert "tests/test_gas.py::test_the_skin_changes_how_often_the_gas_is_searched_not_the_answer" in slow
+    assert "tests/test_gas.py::test_the_skin_tuner_settles_at_the_cheapest_skin" not in slow
+    assert {t for t in every if t.startswith("tests/test_verify.py")} <= slow   # verify.py runs
+    quick = collected("-m", "not mpi and not long and not slow", "tests/test_gas.py")
+    assert quick and not quick & slow
