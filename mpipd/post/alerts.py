@@ -101,7 +101,7 @@ def no_force(run, model, end=None) -> list[dict]:
              "message": f"most of the gas carries no force: {count} gas points {since} (no gas "
                         "neighbourhood, or a family collapsing in a step): the charge no "
                         "longer pushes on the rock through them",
-             "fix": _wall_fix(model, _held_by(model)) + ", so that it keeps its neighbours"}]
+             "fix": _wall_fix(model, _held_by(model), ", so that it keeps its neighbours")}]
 
 
 def leaving(run, model, tube_result=None) -> list[dict]:
@@ -172,12 +172,18 @@ def _held_by(model) -> list[str]:
     return [m for m in tubes if m] or ([model.rock_material] if model.rock_material else [])
 
 
-def _wall_fix(model, solids) -> str:
+def _wall_fix(model, solids, why: str = "") -> str:
     mats = sorted({c["material"] for c in model.charges})
     solid = solids[0] if solids else "<solid>"
+    wall = getattr(model.explosive, "wall", None)
+    if wall is not None:            # held at the tube's face already: it leaves by its ends
+        return (f"the gas is held at the surface of {wall.material!r} already "
+                "(its `wall`); it leaves through the tube's open ends: a specimen as thin "
+                "as its charge is long vents the charge within microseconds (a charge "
+                "shorter than the rock, or a thicker specimen, keeps it longer)")
     return (" or ".join(f"`materials.{m}.wall = {{ material = \"{solid}\" }}`" for m in mats)
             + " holds the gas at that solid's surface (the solid must be in the explosive's "
-            "`interacts_with`)")
+            "`interacts_with`)" + why)
 
 
 def lattice(run, model, measures=None) -> list[dict]:
