@@ -136,7 +136,7 @@ def test_copper_above_the_critical_step_is_refused_unless_forced(tmp_path):
     assert "exceeds the stable estimate" in res.stderr and "--force" in res.stderr
     assert not (tmp_path / "a" / "run.h5").exists()
     chk = run_cli(["check", str(f)])
-    assert chk.returncode == 0 and "TOO LARGE" in chk.stdout and "'m' (j2)" in chk.stdout
+    assert chk.returncode == 2 and "TOO LARGE" in chk.stdout and "'m' (j2)" in chk.stdout
     # forced: the run goes ahead with a warning.  The Silling-Askari estimate is
     # conservative for the correspondence model (measured: copper at 0.3 mm runs
     # stably to 1.7 x and blows up at 1.85 x), so at 1.1 x it completes
@@ -539,9 +539,10 @@ def test_jh2_block_at_extreme_strain_rates(team, rate, kind):
 # at r0 = 3.6-5.6 mm, every such point failed; 74 m/s beyond two horizons of the wall).
 # The scene's integration: ratio 4 since blast_demo steps so (the figures below give
 # both, measured on this reduction with time.multirate={max_ratio=1} and without).
-# Both under the scenes' model of then (Eq. 25's pressure, no gas-solid contact: the case
+# Both under the scenes' model of then (Eq. 25's pressure, no gas-solid contact or wall: the case
 # previous_model), in which they were measured.
-_THEN = ['materials.granite.pressure="eos"', "materials.explosive.contact=false"]
+_THEN = ['materials.granite.pressure="eos"', "materials.explosive.contact=false",
+         "materials.explosive.wall=false"]
 COUPLING = {"paper": ['materials.explosive.interacts_with=["copper"]'] + _THEN,
             "contained": ['materials.explosive.interacts_with=["copper", "granite"]'] + _THEN}
 
@@ -565,6 +566,11 @@ def blast_08(team, request):
     return sim, sim.energies(), worst, request.param
 
 
+# The two cases of the model of then run for minutes each (serial, in process); since
+# the scenes hold the gas with the wall (notes §51) they guard a superseded
+# configuration and moved to the long tier (make stability), keeping make test under
+# its 20 minutes
+@pytest.mark.long
 def test_blast_at_the_paper_rock_resolution_stays_physical(blast_08):
     sim, e, _, coupling = blast_08
     n = sim.points.n_owned
@@ -590,6 +596,7 @@ def test_blast_at_the_paper_rock_resolution_stays_physical(blast_08):
     assert sim.failure_counts()[2] == 0                  # no JH2 tensile artefacts (32 before)
 
 
+@pytest.mark.long
 def test_blast_ledger_closes(blast_08):
     from conftest import closure_without
     sim, e, worst, _ = blast_08

@@ -47,6 +47,7 @@ import numba
 import numpy as np
 
 from .index import family, neighbour
+from .ul import add_moment, current_bond
 
 #: a middle spread at least PLANAR times the least: the points span a plane
 PLANAR = 4.0
@@ -69,10 +70,8 @@ def edge_factor(i, y, offsets, nbr, is_wall, di, t0, t1, t2, li):
         j = neighbour(nbr, b)
         if not is_wall[j]:
             continue
-        y0 = y[j, 0] - y[i, 0]
-        y1 = y[j, 1] - y[i, 1]
-        y2 = y[j, 2] - y[i, 2]
-        if math.sqrt(y0 * y0 + y1 * y1 + y2 * y2) >= di:     # as in wall_update
+        y0, y1, y2, ly = current_bond(y, i, j)
+        if ly >= di:                            # as in wall_update
             continue
         s = max(s, -(y0 * t0 + y1 * t1 + y2 * t2) / lt)
     if s >= 0.0:
@@ -107,10 +106,7 @@ def wall_update(gas_idx, y, offsets, nbr, is_wall, N_ref, l_wall, delta, ell, g0
             j = neighbour(nbr, b)
             if not is_wall[j]:
                 continue
-            y0 = y[j, 0] - y[i, 0]
-            y1 = y[j, 1] - y[i, 1]
-            y2 = y[j, 2] - y[i, 2]
-            ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            y0, y1, y2, ly = current_bond(y, i, j)
             if ly >= di:
                 continue
             w = (1.0 - ly / di) ** 2
@@ -118,12 +114,7 @@ def wall_update(gas_idx, y, offsets, nbr, is_wall, N_ref, l_wall, delta, ell, g0
             c0 += w * y0
             c1 += w * y1
             c2 += w * y2
-            C[0, 0] += w * y0 * y0
-            C[0, 1] += w * y0 * y1
-            C[0, 2] += w * y0 * y2
-            C[1, 1] += w * y1 * y1
-            C[1, 2] += w * y1 * y2
-            C[2, 2] += w * y2 * y2
+            add_moment(C, w, y0, y1, y2)
             n0 += w * N_ref[j, 0]
             n1 += w * N_ref[j, 1]
             n2 += w * N_ref[j, 2]
@@ -205,10 +196,7 @@ def wall_gather(rows, y, offsets, nbr, is_gas, is_wall, delta, gw, gF, V_ref, f,
                 j = neighbour(nbr, b)
                 if not is_gas[j] or (gw[j, 0] == 0.0 and gw[j, 1] == 0.0 and gw[j, 2] == 0.0):
                     continue
-                y0 = y[j, 0] - y[i, 0]
-                y1 = y[j, 1] - y[i, 1]
-                y2 = y[j, 2] - y[i, 2]
-                ly = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+                y0, y1, y2, ly = current_bond(y, i, j)
                 dj = delta[j]
                 if ly >= dj:
                     continue

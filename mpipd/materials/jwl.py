@@ -63,6 +63,14 @@ class BulkViscosity:
         non_negative(self, path, "quadratic", "linear")
 
 
+def _reach_check(law, path, of: str):
+    """A contact law's ``distance`` (a fraction of ``of``, at most 1) and ``stiffness``
+    are positive."""
+    positive(law, path, "distance", "stiffness")
+    if law.distance > 1.0:
+        fail(join(path, "distance"), f"must be at most 1 (a fraction of {of})")
+
+
 @dataclass(frozen=True)
 class GasContact:
     """Non-penetration of the gas and the solids it acts on (not in the paper).
@@ -92,10 +100,7 @@ class GasContact:
     stiffness: float = 1.0
 
     def check(self, path):
-        positive(self, path, "distance", "stiffness")
-        if self.distance > 1.0:
-            fail(join(path, "distance"), "must be at most 1 (a fraction of the pair's "
-                                         "lattice spacing)")
+        _reach_check(self, path, "the pair's lattice spacing")
 
 
 @dataclass(frozen=True)
@@ -134,10 +139,7 @@ class GasWall:
     stiffness: float = 2.0
 
     def check(self, path):
-        positive(self, path, "distance", "stiffness")
-        if self.distance > 1.0:
-            fail(join(path, "distance"), "must be at most 1 (a fraction of the gas's "
-                                         "lattice spacing)")
+        _reach_check(self, path, "the gas's lattice spacing")
 
 
 @dataclass(frozen=True)

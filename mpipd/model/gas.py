@@ -335,6 +335,11 @@ class Gas(Model):
             add("gas_wall_F", own, self.gF, rows=LOCAL, checkpoint=True)
             add("gas_wall_fw", own, self.fw, rows=AUX)
             add("gas_wall_fw_old", own, self.fw_old, rows=AUX)
+            add("gas_wall_ell", own, self.ell, rows=self.gas_idx)
+            for name in ("wall_gid", "wall_N", "wall_l"):     # the table of all wall points
+                add(f"gas_{name}", own, getattr(self, name), rows=AUX)
+            for name in ("wall_ext", "wallN_ext", "walll_ext"):
+                add(f"gas_{name}", own, get=lambda name=name: getattr(self, name), rows=AUX)
             state.scalar("gas_wall_work", own, lambda: self.wall_work,
                          lambda v: setattr(self, "wall_work", float(v)))
         if self.viscous:
