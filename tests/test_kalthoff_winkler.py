@@ -88,6 +88,7 @@ def coarse(tmp_path_factory):
     return out
 
 
+@pytest.mark.long      # three 60 us runs: make stability, to keep make test under 20 min
 def test_one_two_and_three_ranks_are_bit_identical(coarse):
     with h5py.File(coarse[1], "r") as f1:
         ref = {k: f1["fields"][k][:] for k in ("u", "v", "damage")}
@@ -98,6 +99,7 @@ def test_one_two_and_three_ranks_are_bit_identical(coarse):
                     np.testing.assert_array_equal(f["fields"][k][:], a, err_msg=f"{k}, {ranks}")
 
 
+@pytest.mark.long      # three 60 us runs: make stability, to keep make test under 20 min
 def test_the_ledger_closes_with_the_boundary_work(coarse):
     """Every frame's |balance| within the ledger's own bound (BALANCE_TOL); the boundary
     term holds the energy the plate received (initial 0)."""
@@ -110,6 +112,7 @@ def test_the_ledger_closes_with_the_boundary_work(coarse):
     assert abs(initial) < 1e-20 and work > 0 and held > 0 and diss > 0
 
 
+@pytest.mark.long      # three 60 us runs: make stability, to keep make test under 20 min
 def test_the_coarse_cracks_leave_both_tips_forward(coarse):
     """At 3 mm and 60 us both tips have cracked, forward and outward (0-90 deg, away
     from the mid-line).  The angle itself is the long test's, at 1.5 mm."""

@@ -12,6 +12,10 @@ from conftest import run_cli
 from mpipd.post import alerts
 from mpipd.post.charges import NAMES
 
+#: two scenes run and reported (about 100 s): the long tier (make stability), to keep
+#: make test under its 20 minutes
+pytestmark = pytest.mark.long
+
 BOX = """
 [scene]
 name = "{name}"
